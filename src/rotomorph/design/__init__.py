@@ -1,0 +1,1 @@
+"""Design layer: paths, print programs, networks and lattices (no mechanics)."""
