@@ -1,0 +1,1 @@
+"""Analysis layer: lengths, areas, curvatures and shape descriptors of solved configurations."""

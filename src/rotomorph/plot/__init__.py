@@ -1,0 +1,1 @@
+"""Figures (matplotlib, Agg) and animations (GIF through Pillow); files written atomically."""
