@@ -1,0 +1,315 @@
+"""One self-describing HDF5 file per run, plus a ``summary.json`` (DESIGN section 7).
+
+Layout (format ``rotomorph.results``, version 1)::
+
+    /                       attrs: format, format_version, design (JSON), metadata (JSON)
+    /topology/edges         (E, 2) int64       segment end-node indices
+    /topology/branch        (N,)   bool        branch-node flags
+    /steps/positions        (S, N, 3) float64  attrs: units = "mm"
+    /steps/scalars/<name>   (S,)   float64     attrs: units  (actuation, energy, ...)
+    /steps/fields/<name>    (S, ...) float64   attrs: units  (per-node or per-edge arrays)
+
+Every dataset carries a ``units`` attribute; ``"1"`` means dimensionless. Files are written
+atomically (:mod:`rotomorph.io.atomic`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.errors import InvalidParameterError
+from rotomorph.io.atomic import atomic_path, atomic_write_text
+
+__all__ = [
+    "DEFAULT_UNITS",
+    "FORMAT",
+    "FORMAT_VERSION",
+    "RunResults",
+    "read_results",
+    "read_summary",
+    "summarize",
+    "to_jsonable",
+    "write_results",
+    "write_summary",
+]
+
+FORMAT = "rotomorph.results"
+FORMAT_VERSION = 1
+
+#: Units of the usual per-step scalars; any other name needs an entry in ``units``.
+DEFAULT_UNITS: Mapping[str, str] = {
+    "actuation": "1",
+    "temperature": "degC",
+    "energy": "N*mm",
+    "iterations": "1",
+    "residual": "1",
+    "area_ratio": "1",
+    "edge_strain": "1",
+    "gaussian_sign": "1",
+    "gaussian_curvature": "1/mm^2",
+    "characteristic_curvature": "1/mm",
+    "end_to_end_ratio": "1",
+    "converged": "1",
+}
+
+
+@dataclass(frozen=True, eq=False)
+class RunResults:
+    """Everything stored for one run (arrays are read-only).
+
+    Attributes
+    ----------
+    design
+        The resolved design (parsed from its JSON attribute).
+    edges
+        ``(E, 2)`` segment end-node indices.
+    branch
+        ``(N,)`` branch-node flags.
+    positions
+        ``(S, N, 3)`` node positions per actuation step (mm).
+    scalars
+        Per-step scalars by name, each ``(S,)``.
+    fields
+        Per-step arrays by name, each ``(S, ...)``.
+    units
+        Unit of every scalar and field by name, and of ``"positions"``.
+    metadata
+        Free-form run information (versions, run id, timings), JSON-compatible.
+    """
+
+    design: Mapping[str, Any]
+    edges: IntArray
+    branch: BoolArray
+    positions: FloatArray
+    scalars: Mapping[str, FloatArray]
+    fields: Mapping[str, FloatArray] = field(default_factory=dict)
+    units: Mapping[str, str] = field(default_factory=dict)
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of stored actuation steps S."""
+        return int(self.positions.shape[0])
+
+
+def to_jsonable(value: Any) -> Any:
+    """Convert numpy scalars/arrays, paths, enums and tuples into JSON types; NaN/inf → None."""
+    if isinstance(value, Enum):
+        return to_jsonable(value.value)
+    if isinstance(value, Mapping):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if value is None or isinstance(value, str):
+        return value
+    raise InvalidParameterError(
+        "value", f"cannot store {type(value).__name__} as JSON; convert it to numbers or text"
+    )
+
+
+def _dumps(value: Any) -> str:
+    return json.dumps(to_jsonable(value), sort_keys=True, allow_nan=False)
+
+
+def _check_name(kind: str, name: str) -> None:
+    if not name or "/" in name or name.startswith("."):
+        raise InvalidParameterError(kind, f"name {name!r} must be non-empty without '/'")
+
+
+def _validate(
+    edges: Any, branch: Any, positions: Any, scalars: Mapping[str, Any], fields: Mapping
+) -> tuple[IntArray, BoolArray, FloatArray, dict[str, FloatArray], dict[str, FloatArray]]:
+    pos = np.asarray(positions, dtype=float)
+    if pos.ndim == 2:
+        pos = pos[None]
+    if pos.ndim != 3 or pos.shape[2] != 3 or pos.shape[0] < 1:
+        raise InvalidParameterError(
+            "positions", f"must have shape (steps, N, 3) in mm; got {np.shape(positions)}"
+        )
+    steps, n = pos.shape[:2]
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if len(e) and (e.min() < 0 or e.max() >= n):
+        raise InvalidParameterError("edges", f"indices must lie in [0, {n - 1}]")
+    b = np.zeros(n, dtype=bool) if branch is None else np.asarray(branch, dtype=bool)
+    if b.shape != (n,):
+        raise InvalidParameterError("branch", f"must have one flag per node ({n}); got {b.shape}")
+    out_s = {}
+    for name, value in scalars.items():
+        _check_name("scalars", name)
+        v = np.asarray(value, dtype=float).reshape(-1)
+        if v.shape != (steps,):
+            raise InvalidParameterError(
+                f"scalars[{name!r}]", f"must have one value per step ({steps}); got {v.size}"
+            )
+        out_s[name] = v
+    out_f = {}
+    for name, value in fields.items():
+        _check_name("fields", name)
+        v = np.asarray(value, dtype=float)
+        if v.ndim < 1 or v.shape[0] != steps:
+            raise InvalidParameterError(
+                f"fields[{name!r}]", f"must have a leading step axis of {steps}; got {v.shape}"
+            )
+        out_f[name] = v
+    return e, b, pos, out_s, out_f
+
+
+def write_results(
+    path: str | os.PathLike[str],
+    *,
+    design: Mapping[str, Any] | str,
+    edges: IntArray,
+    branch: BoolArray | None,
+    positions: FloatArray,
+    scalars: Mapping[str, Any],
+    fields: Mapping[str, Any] | None = None,
+    units: Mapping[str, str] | None = None,
+    metadata: Mapping[str, Any] | None = None,
+) -> Path:
+    """Write one run's results to an HDF5 file atomically and return its path.
+
+    Parameters
+    ----------
+    path
+        Destination (``.h5``); its folder must exist.
+    design
+        The resolved design as a JSON-compatible mapping, or as a JSON string.
+    edges
+        ``(E, 2)`` segment end-node indices (e.g. ``network.edges``).
+    branch
+        ``(N,)`` branch flags (e.g. ``network.branch``); ``None`` stores all False.
+    positions
+        ``(S, N, 3)`` node positions per actuation step (mm); ``(N, 3)`` is one step.
+    scalars
+        Per-step scalars by name, each of length S (NaN allowed for a failed step).
+    fields
+        Per-step arrays by name, each with leading axis S (e.g. ``(S, N)`` curvature change).
+    units
+        Units by name; names in :data:`DEFAULT_UNITS` may be omitted, any other is required.
+    metadata
+        JSON-compatible run information.
+
+    Raises
+    ------
+    InvalidParameterError
+        Inconsistent shapes, a name without a unit, or a value that is not JSON-compatible.
+    """
+    fields = dict(fields or {})
+    e, b, pos, sc, fl = _validate(edges, branch, positions, scalars, fields)
+    all_units = {"positions": "mm", **DEFAULT_UNITS, **dict(units or {})}
+    for name in [*sc, *fl]:
+        if name not in all_units:
+            raise InvalidParameterError(
+                "units", f"give a unit for {name!r} (use '1' for dimensionless)"
+            )
+    design_json = design if isinstance(design, str) else _dumps(design)
+    try:
+        json.loads(design_json)
+    except json.JSONDecodeError as err:
+        raise InvalidParameterError("design", f"is not valid JSON: {err}") from err
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as h5:
+        h5.attrs["format"] = FORMAT
+        h5.attrs["format_version"] = FORMAT_VERSION
+        h5.attrs["design"] = design_json
+        h5.attrs["metadata"] = _dumps(metadata or {})
+        topo = h5.create_group("topology")
+        topo.create_dataset("edges", data=e)
+        topo.create_dataset("branch", data=b)
+        steps = h5.create_group("steps")
+        ds = steps.create_dataset("positions", data=pos, compression="gzip", shuffle=True)
+        ds.attrs["units"] = all_units["positions"]
+        g = steps.create_group("scalars")
+        for name, value in sc.items():
+            g.create_dataset(name, data=value).attrs["units"] = all_units[name]
+        g = steps.create_group("fields")
+        for name, value in fl.items():
+            d = g.create_dataset(name, data=value, compression="gzip", shuffle=True)
+            d.attrs["units"] = all_units[name]
+    return Path(path)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
+
+
+def read_results(path: str | os.PathLike[str]) -> RunResults:
+    """Read a file written by :func:`write_results`.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the file is not a rotomorph results file or has a newer format version.
+    """
+    with h5py.File(path, "r") as h5:
+        if h5.attrs.get("format") != FORMAT:
+            raise InvalidParameterError("path", f"{path} is not a {FORMAT} file")
+        version = int(h5.attrs["format_version"])
+        if version > FORMAT_VERSION:
+            raise InvalidParameterError(
+                "path", f"format version {version} is newer than {FORMAT_VERSION}; upgrade"
+            )
+        units = {"positions": str(h5["steps/positions"].attrs["units"])}
+        scalars, fields = {}, {}
+        for name, ds in h5["steps/scalars"].items():
+            scalars[name] = _frozen(ds[()])
+            units[name] = str(ds.attrs["units"])
+        for name, ds in h5["steps/fields"].items():
+            fields[name] = _frozen(ds[()])
+            units[name] = str(ds.attrs["units"])
+        return RunResults(
+            design=json.loads(h5.attrs["design"]),
+            edges=_frozen(h5["topology/edges"][()].astype(np.int64).reshape(-1, 2)),
+            branch=_frozen(h5["topology/branch"][()].astype(bool)),
+            positions=_frozen(h5["steps/positions"][()]),
+            scalars=scalars,
+            fields=fields,
+            units=units,
+            metadata=json.loads(h5.attrs["metadata"]),
+        )
+
+
+def summarize(results: RunResults) -> dict[str, Any]:
+    """A JSON-compatible summary: sizes, units and the first/last value of every scalar."""
+    return {
+        "format": FORMAT,
+        "n_steps": results.n_steps,
+        "n_nodes": int(results.positions.shape[1]),
+        "n_edges": len(results.edges),
+        "final": {k: to_jsonable(v[-1]) for k, v in results.scalars.items()},
+        "initial": {k: to_jsonable(v[0]) for k, v in results.scalars.items()},
+        "units": dict(results.units),
+        "metadata": to_jsonable(results.metadata),
+    }
+
+
+def write_summary(path: str | os.PathLike[str], summary: Mapping[str, Any]) -> Path:
+    """Write ``summary`` as indented, key-sorted strict JSON (NaN/inf → null), atomically."""
+    text = json.dumps(to_jsonable(summary), indent=2, sort_keys=True, allow_nan=False)
+    return atomic_write_text(path, text + "\n")
+
+
+def read_summary(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """Read a ``summary.json``."""
+    return json.loads(Path(path).read_text(encoding="utf-8"))
