@@ -1,0 +1,321 @@
+r"""Assembly: print program + materials + temperature → natural curvature, twist, stiffness.
+
+Frame A of the physics notes (1.5): the material director of every edge is the interface normal
+m1 = n (pointing into the active phase), n = cos α d1 + sin α d2 with d1 the space-parallel
+reference director of :func:`rotomorph.geometry.space_parallel_directors`. The printed filament
+is stress-free in its printed shape, so its printed curvatures and twist are measured on the
+printed polyline with :func:`rotomorph.geometry.polyline_strains` (as disMech sets κ̄ = κ at
+set-up), divided by the printed Voronoi lengths; actuation adds, scaled by the actuation
+fraction x(T),
+
+* κ̄1 += K_J (curvature toward m1 = n, i.e. toward the active side), κ̄2 += K_2 (zero for a
+  symmetric Janus section), τ̄ += Δτ (eigen-twist of the helical director),
+* rest length = printed length × exp(x ε_c) (Hencky) or (1 + x ε_c) (engineering),
+
+with K_J, Δτ, ε_c from the section of each edge (print speed and rotation averaged over the two
+end vertices) and averaged over the two edges of each interior vertex.
+
+Moduli at the actuation temperature are not measured (notes 1.2, Q9). The passive modulus is
+taken at its 25 °C value and the active one as ``FilamentModel.modulus_ratio`` × E_p: the
+room-temperature ratio 52 under-predicts the Janus curvature 2-4× (notes 1.7), so the ratio is
+calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for unloaded shapes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from rotomorph import geometry
+from rotomorph._typing import FloatArray
+from rotomorph.errors import InvalidDesignError, InvalidParameterError, MaterialError
+from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection, filament_section
+from rotomorph.materials.material import Material, get_material
+from rotomorph.materials.morphology import HelixShape, free_helix
+from rotomorph.materials.process import (
+    ActuationStrainModel,
+    WarnerTerentjev,
+    actuation_fraction,
+    dimensionless_rotation,
+)
+
+#: Effective E_a/E_p at actuation (Hencky WT strains, Q = S), calibrated on K_J(v = 3 mm/s) =
+#: 0.59 ± 0.04 mm⁻¹ with ``calibrate(load_table("janus_curvature"), ["modulus_ratio"], use=[3])``:
+#: 4.12 ± 1.2 (notes 1.7 quote 4.1). Re-run the calibration when changing the strain model.
+CALIBRATED_MODULUS_RATIO = 4.12
+
+
+@dataclass(frozen=True)
+class FilamentModel:
+    """Modelling choices of the print-to-shape chain (all can be calibrated).
+
+    Parameters
+    ----------
+    strain_model
+        Actuation strains of the LCE vs print speed (:mod:`rotomorph.materials.process`).
+    modulus_ratio
+        Effective E_a/E_p at the actuation temperature (dimensionless) or ``None`` for the
+        materials' 25 °C ratio (52 for the paper's inks; known to under-predict curvature).
+    passive_strain
+        Free strain of the passive ink at full actuation (dimensionless, in the strain model's
+        measure) or ``None`` to take it from the material's ``actuation_length``.
+    transition_width
+        Width of the actuation sigmoid through T_NI (°C).
+    hysteresis
+        Width of the heating/cooling hysteresis loop (°C).
+    direction
+        ``"heating"`` or ``"cooling"`` branch of the actuation curve.
+    resolution
+        Boundary vertices of the section mesh.
+    """
+
+    strain_model: ActuationStrainModel = field(default_factory=WarnerTerentjev)
+    modulus_ratio: float | None = CALIBRATED_MODULUS_RATIO
+    passive_strain: float | None = None
+    transition_width: float = 10.0
+    hysteresis: float = 0.0
+    direction: Literal["heating", "cooling"] = "heating"
+    resolution: int = DEFAULT_RESOLUTION
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.strain_model, ActuationStrainModel):
+            raise InvalidParameterError(
+                "FilamentModel.strain_model", "must implement active_strains(speed) and measure"
+            )
+        if self.modulus_ratio is not None and not (
+            np.isfinite(self.modulus_ratio) and self.modulus_ratio > 0.0
+        ):
+            raise InvalidParameterError(
+                "FilamentModel.modulus_ratio", f"must be > 0 or None; got {self.modulus_ratio}"
+            )
+        if self.passive_strain is not None and not np.isfinite(self.passive_strain):
+            raise InvalidParameterError("FilamentModel.passive_strain", "must be finite or None")
+
+    def moduli(self, active: Material, passive: Material) -> tuple[float, float]:
+        """(E_a, E_p) in MPa used for the section at actuation (see module docstring)."""
+        e_p = passive.youngs_modulus
+        if self.modulus_ratio is None:
+            return active.youngs_modulus, e_p
+        return self.modulus_ratio * e_p, e_p
+
+    def section(
+        self, active: Material, passive: Material, radius: float, active_fraction: float
+    ) -> FilamentSection:
+        """The (cached) meshed section for these materials and geometry."""
+        e_a, e_p = self.moduli(active, passive)
+        return filament_section(
+            radius,
+            e_a,
+            e_p,
+            poisson_active=active.poisson_ratio,
+            poisson_passive=passive.poisson_ratio,
+            active_fraction=active_fraction,
+            resolution=self.resolution,
+        )
+
+    def strains(
+        self, speed: float | FloatArray, passive: Material
+    ) -> tuple[FloatArray, FloatArray, float]:
+        """Full-actuation (ε∥, ε⊥, ε_p) (dimensionless) for print speed v (mm/s)."""
+        e_par, e_perp = self.strain_model.active_strains(speed)
+        eps_p = (
+            passive.free_strain(self.strain_model.measure)
+            if self.passive_strain is None
+            else float(self.passive_strain)
+        )
+        return e_par, e_perp, eps_p
+
+
+@dataclass(frozen=True, eq=False)
+class NaturalField:
+    """Natural (stress-free) state and stiffness of one filament in DER conventions (Frame A).
+
+    Attributes
+    ----------
+    directors
+        ``(N-1, 3)`` unit interface normals n = m1 of the edges (into the active phase).
+    curvature1, curvature2, twist
+        ``(N-2,)`` natural curvature toward m1, m2 and twist at interior vertices (1/mm); the rod
+        core multiplies them by its Voronoi length to get integrated values. The printed part is
+        exact when multiplied by ``voronoi_length`` (printed).
+    voronoi_length
+        ``(N-2,)`` printed Voronoi lengths (mm).
+    rest_length
+        ``(N-1,)`` natural edge lengths after actuation (mm).
+    axial_strain
+        ``(N-1,)`` applied natural centre-line strain x·ε_c (dimensionless, model's measure).
+    bending_stiffness1, bending_stiffness2, twist_stiffness
+        ``(N-1,)`` B1 (toward m1 = n), B2, C (N·mm²).
+    axial_stiffness
+        ``(N-1,)`` EA (N).
+    actuation
+        Actuation fraction x ∈ [0, 1] at the given temperature.
+    measure
+        Strain measure used for ``rest_length``.
+    """
+
+    directors: FloatArray
+    curvature1: FloatArray
+    curvature2: FloatArray
+    twist: FloatArray
+    voronoi_length: FloatArray
+    rest_length: FloatArray
+    axial_strain: FloatArray
+    bending_stiffness1: FloatArray
+    bending_stiffness2: FloatArray
+    twist_stiffness: FloatArray
+    axial_stiffness: FloatArray
+    actuation: float
+    measure: Literal["hencky", "engineering"] = "hencky"
+
+    def morphology(self, *, rtol: float = 1e-6) -> HelixShape:
+        """Closed-form free-filament helix (notes 1.6) for a uniform natural field.
+
+        Raises
+        ------
+        InvalidDesignError
+            The curvature, twist or axial strain vary along the filament by more than ``rtol``
+            relative to the field's scale (use the rod solver for non-uniform fields).
+        """
+        k = np.hypot(self.curvature1, self.curvature2)
+        scale = max(float(np.max(np.abs(k))), float(np.max(np.abs(self.twist))), 1e-12)
+        for name, arr, s in (
+            ("curvature", k, scale),
+            ("twist", self.twist, scale),
+            ("axial_strain", self.axial_strain, 1.0),
+        ):
+            if np.ptp(arr) > rtol * s:
+                raise InvalidDesignError(
+                    f"NaturalField.{name}",
+                    "varies along the filament; the closed-form helix needs a uniform field",
+                )
+        return free_helix(
+            float(np.mean(k)),
+            float(np.mean(self.twist)),
+            float(np.mean(self.axial_strain)),
+            measure=self.measure,
+        )
+
+
+def _program_arrays(
+    program: Any,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float, float]:
+    pts = np.asarray(program.points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 3 or not np.all(np.isfinite(pts)):
+        raise InvalidDesignError("PrintProgram.points", "must be finite (N, 3) mm with N >= 3")
+    n = len(pts)
+    speed = np.asarray(program.speed, dtype=float).reshape(-1)
+    rot = np.asarray(program.rotation, dtype=float).reshape(-1)
+    alpha = np.asarray(program.interface_angle, dtype=float).reshape(-1)
+    for name, arr, size in (
+        ("speed", speed, n),
+        ("rotation", rot, n),
+        ("interface_angle", alpha, n - 1),
+    ):
+        if arr.shape != (size,) or not np.all(np.isfinite(arr)):
+            raise InvalidDesignError(f"PrintProgram.{name}", f"must be {size} finite values")
+    if np.any(speed <= 0.0):
+        i = int(np.argmax(speed <= 0.0))
+        raise InvalidDesignError(
+            "PrintProgram.speed", f"must be > 0 mm/s; got {speed[i]} at vertex {i}"
+        )
+    radius = float(program.radius)
+    if not np.isfinite(radius) or radius <= 0.0:
+        raise InvalidDesignError("PrintProgram.radius", f"must be > 0 mm; got {radius}")
+    frac = float(program.active_fraction)
+    if not 0.0 < frac <= 1.0:
+        raise InvalidDesignError("PrintProgram.active_fraction", f"must lie in (0, 1]; got {frac}")
+    return pts, speed, rot, alpha, radius, frac
+
+
+def _material(name: str, materials: Mapping[str, Material] | None, kind: str) -> Material:
+    mat = get_material(name) if materials is None or name not in materials else materials[name]
+    if mat.kind != kind:
+        raise MaterialError(f"PrintProgram.{kind}_material", f"{name!r} is {mat.kind}, not {kind}")
+    return mat
+
+
+def natural_field(
+    program: Any,
+    materials: Mapping[str, Material] | None = None,
+    temperature: float = 175.0,
+    *,
+    model: FilamentModel | None = None,
+) -> NaturalField:
+    """Natural curvature, twist, rest lengths and stiffnesses of one printed filament.
+
+    Parameters
+    ----------
+    program
+        Print program with ``points`` (N, 3) mm, ``speed`` (N,) mm/s, ``rotation`` (N,) rad/s,
+        ``interface_angle`` (N-1,) rad (from d1 toward d2 = t × d1), ``radius`` mm,
+        ``active_fraction`` in (0, 1], ``active_material`` and ``passive_material`` names.
+    materials
+        Name → :class:`Material` overrides; names not in it come from the registry.
+    temperature
+        Actuation temperature T (°C); the paper actuates at 150-175 °C (full actuation).
+    model
+        Modelling choices; default :class:`FilamentModel` (WT strains, calibrated ratio).
+
+    Returns
+    -------
+    NaturalField
+
+    Raises
+    ------
+    InvalidDesignError
+        Malformed program (shapes, non-positive speed or radius, bad active fraction).
+    MaterialError
+        Unknown material names or an active/passive mix-up.
+    """
+    model = FilamentModel() if model is None else model
+    pts, speed, rot, alpha, radius, frac = _program_arrays(program)
+    active = _material(program.active_material, materials, "active")
+    passive = _material(program.passive_material, materials, "passive")
+    x = float(
+        actuation_fraction(
+            temperature,
+            active.transition_temperature,  # type: ignore[arg-type]
+            model.transition_width,
+            direction=model.direction,
+            hysteresis=model.hysteresis,
+        )
+    )
+    edge_speed = 0.5 * (speed[:-1] + speed[1:])
+    edge_rot = 0.5 * (rot[:-1] + rot[1:])
+    omega_star = dimensionless_rotation(edge_rot, edge_speed, radius)
+    section = model.section(active, passive, radius, frac)
+    e_par, e_perp, eps_p = model.strains(edge_speed, passive)
+    eps_c, kappa, dtau = section.natural_strains(omega_star, e_par, e_perp, eps_p)
+
+    d1 = geometry.space_parallel_directors(pts)
+    t = geometry.unit(np.diff(pts, axis=0))
+    directors = geometry.rotate_about_tangent(d1, t, alpha)
+    k1, k2, tw, vor = geometry.polyline_strains(pts, directors)
+
+    def at_vertices(a: FloatArray) -> FloatArray:
+        return 0.5 * (a[:-1] + a[1:])
+
+    lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    measure = model.strain_model.measure
+    axial = x * eps_c
+    stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
+    ones = np.ones(len(lengths))
+    return NaturalField(
+        directors=directors,
+        curvature1=k1 / vor + x * at_vertices(kappa[:, 0]),
+        curvature2=k2 / vor + x * at_vertices(kappa[:, 1]),
+        twist=tw / vor + x * at_vertices(dtau),
+        voronoi_length=vor,
+        rest_length=lengths * stretch,
+        axial_strain=axial,
+        bending_stiffness1=section.bending_stiffness1 * ones,
+        bending_stiffness2=section.bending_stiffness2 * ones,
+        twist_stiffness=section.twist_stiffness * ones,
+        axial_stiffness=section.axial_stiffness * ones,
+        actuation=x,
+        measure=measure,
+    )

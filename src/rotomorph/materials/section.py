@@ -1,0 +1,135 @@
+r"""General cross-section mechanics by quadrature: axial stretch and bending (plane sections).
+
+For a section with Young's modulus field E(x) and axial eigenstrain field ε*_zz(x), minimising
+½∫E(ε_zz − ε*_zz)² dA over ε_zz = ε_c − κ·(x − c) gives (physics notes 1.4; the bimetal
+set-up of Timoshenko, J. Opt. Soc. Am. 11, 233 (1925), generalised to any section):
+
+=========  ==========================================================  ==========
+symbol     definition                                                  unit
+=========  ==========================================================  ==========
+A_E        ∫E dA  (axial stiffness EA)                                 N
+c          ∫E x dA / A_E  (modulus-weighted centroid)                  mm
+I_E        ∫E (x − c)(x − c)ᵀ dA  (2×2 bending stiffness)              N·mm²
+ε_c        ∫E ε*_zz dA / A_E  (natural centre-line strain)             1
+κ̄          −I_E⁻¹ ∫E ε*_zz (x − c) dA  (natural curvature)             1/mm
+=========  ==========================================================  ==========
+
+κ̄_i is the curvature component toward m_i (fibres on that side are shortened), the DER
+component convention of Bergou et al. (2008) used by :mod:`rotomorph.geometry`; with x1 along
+the interface normal n (into the active phase) a contracting active phase gives κ̄_1 > 0.
+
+Every field is given either as an array over the mesh's quadrature points or as a callable
+``field(xy, active) -> values`` evaluated there (xy in mm, ``active`` a boolean mask);
+:func:`phase_constant` builds the common piecewise-constant case. Because ε_c and κ̄ are linear in
+ε*_zz, :class:`AxialSection` stores them as linear functionals on the quadrature values, so many
+eigenstrain fields (one per rod edge) are evaluated with one matrix product.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from rotomorph._typing import BoolArray, FloatArray
+from rotomorph.errors import InvalidParameterError
+from rotomorph.materials.mesh import SectionMesh
+
+Field = Callable[[FloatArray, BoolArray], FloatArray]
+
+
+def phase_constant(active: float, passive: float) -> Field:
+    """Piecewise-constant field: ``active`` on the active phase, ``passive`` elsewhere."""
+
+    def field(xy: FloatArray, is_active: BoolArray) -> FloatArray:
+        return np.where(is_active, float(active), float(passive))
+
+    return field
+
+
+def evaluate(field: Field | FloatArray | float, xy: FloatArray, active: BoolArray) -> FloatArray:
+    """Values of ``field`` at quadrature points ``xy`` ``(Q, 2)`` (mm): ``(Q,)`` or ``(..., Q)``."""
+    if callable(field):
+        out = np.asarray(field(xy, active), dtype=float)
+    else:
+        out = np.asarray(field, dtype=float)
+    out = np.broadcast_to(out, (*out.shape[:-1], len(xy))) if out.ndim else np.full(len(xy), out)
+    if not np.all(np.isfinite(out)):
+        raise InvalidParameterError("field", "must be finite at every quadrature point")
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class AxialSection:
+    """Stiffness of a section and the linear maps eigenstrain → natural strain and curvature.
+
+    Build with :func:`axial_section`. Attributes: ``axial_stiffness`` A_E (N), ``centroid`` c
+    ``(2,)`` (mm), ``bending_matrix`` I_E ``(2, 2)`` (N·mm²), quadrature ``points`` ``(Q, 2)``
+    (mm), ``weights`` ``(Q,)`` (mm²), ``active`` ``(Q,)`` and ``modulus`` E at the points (MPa).
+    """
+
+    axial_stiffness: float
+    centroid: FloatArray
+    bending_matrix: FloatArray
+    points: FloatArray
+    weights: FloatArray
+    active: BoolArray
+    modulus: FloatArray
+
+    @property
+    def bending_stiffness1(self) -> float:
+        """B1 = I_E[0, 0]: stiffness paired with curvature toward m1 = n (N·mm²)."""
+        return float(self.bending_matrix[0, 0])
+
+    @property
+    def bending_stiffness2(self) -> float:
+        """B2 = I_E[1, 1]: stiffness paired with curvature toward m2 = t × n (N·mm²)."""
+        return float(self.bending_matrix[1, 1])
+
+    def principal_stiffnesses(self) -> tuple[FloatArray, FloatArray]:
+        """Eigenvalues (ascending, N·mm²) and unit eigenvectors (columns, (m1, m2) components)."""
+        return np.linalg.eigh(self.bending_matrix)
+
+    def natural_strain(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
+        """ε_c = ∫E ε*_zz dA / A_E (dimensionless); ``(...)`` for values ``(..., Q)``."""
+        eps = evaluate(eigenstrain, self.points, self.active)
+        return eps @ (self.modulus * self.weights) / self.axial_stiffness
+
+    def natural_curvature(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
+        """κ̄ = −I_E⁻¹ ∫E ε*_zz (x − c) dA (1/mm), components toward (m1, m2): ``(..., 2)``."""
+        eps = evaluate(eigenstrain, self.points, self.active)
+        lever = (self.modulus * self.weights)[:, None] * (self.points - self.centroid)
+        moment = eps @ lever
+        return -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0]
+
+
+def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> AxialSection:
+    """Quadrature of A_E, c and I_E for a meshed section with Young's modulus field E (MPa).
+
+    Parameters
+    ----------
+    mesh
+        Triangulated section (mm); see :mod:`rotomorph.materials.mesh`.
+    modulus
+        E at the quadrature points (MPa), > 0, or a field callable.
+
+    Returns
+    -------
+    AxialSection
+
+    Examples
+    --------
+    A homogeneous disk of radius R gives I_E = E π R⁴/4 · identity (up to the polygon error of
+    the mesh), a Janus half-and-half disk with E_a = E_p gives the same.
+    """
+    xy, w, act, _ = mesh.quadrature()
+    e = evaluate(modulus, xy, act)
+    if np.any(e <= 0.0):
+        raise InvalidParameterError("modulus", "Young's modulus must be > 0 MPa everywhere")
+    ew = e * w
+    a_e = float(ew.sum())
+    c = ew @ xy / a_e
+    d = xy - c
+    i_e = (ew[:, None, None] * d[:, :, None] * d[:, None, :]).sum(axis=0)
+    return AxialSection(a_e, c, i_e, xy, w, act, e)
