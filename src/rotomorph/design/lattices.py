@@ -1,0 +1,395 @@
+r"""The paper's square lattice of sinusoidal edges (Methods, "Numerical simulation"; notes 2.7).
+
+Layout and numbering
+--------------------
+* Branch nodes ``k = n*i + j`` (row-major) at :math:`(l\,i, l\,j, 0)`, ``i, j = 0..n-1``; they are
+  nodes ``0 .. n²-1`` of the :class:`~rotomorph.design.network.Network`.
+* Lattice edges (``2 n (n-1)``; 40 for n = 5), always oriented from the lower to the higher
+  branch index, so the tangent T is +x or +y:
+  first the x-edges ``(i, j) -> (i+1, j)`` ordered by ``j`` then ``i``, then the y-edges
+  ``(i, j) -> (i, j+1)`` ordered by ``i`` then ``j``.
+* Ghost nodes of lattice edge ``e`` (paper's formula, notes Q8: N = ẑ × T on EVERY edge):
+
+  .. math:: v(s) = v_{start} + T\,s\,l/(n_g+1) + N\,A\sin(2\pi s/(n_g+1)),\quad s = 1..n_g,
+
+  numbered ``n² + e*n_g + (s-1)``. Each edge is one sine period, so branch nodes are inflection
+  points. Network segments run in chain order along each edge, in edge order.
+* Modes: ``'expanding'`` = active on the outer side of the edge's curvature (straightens),
+  ``'contracting'`` = active inner (curls) [PAPER]; the active side flips by π at each inflection.
+* Print programs: every line of edges along x (fixed ``j``) and along y (fixed ``i``) is one
+  continuous filament printed in +x / +y, so program edges have the network's orientation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Literal, Union
+
+import numpy as np
+
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.design.network import Network
+from rotomorph.design.path import Path
+from rotomorph.design.program import PrintProgram, active_side_angle
+from rotomorph.errors import InvalidDesignError
+
+__all__ = ["MODES", "PATTERNS", "Lattice", "sinusoidal_lattice"]
+
+MODES = ("expanding", "contracting")
+PATTERNS = ("expanding", "contracting", "dome", "saddle")
+Centre = Literal["central_cells", "interior"]
+Pattern = Union[str, Sequence[str], Mapping[Union[int, tuple[int, int]], str]]  # noqa: UP007
+
+
+def _edge_list(n: int) -> IntArray:
+    ex = [(n * i + j, n * (i + 1) + j) for j in range(n) for i in range(n - 1)]
+    ey = [(n * i + j, n * i + j + 1) for i in range(n) for j in range(n - 1)]
+    return np.array(ex + ey, dtype=np.int64)
+
+
+def _central(n: int, edges: IntArray, centre: str) -> np.ndarray:
+    i, j = np.divmod(edges, n)
+    interior = (i > 0) & (i < n - 1) & (j > 0) & (j < n - 1)
+    if centre == "central_cells":
+        # both end nodes strictly inside: the 2x2 central cells for n = 5 (12 edges; notes Q12)
+        return interior.all(axis=1)
+    if centre == "interior":
+        # every edge not on the perimeter (24 of 40 for n = 5)
+        along_x = j[:, 0] == j[:, 1]
+        on_border = np.where(
+            along_x, (j[:, 0] == 0) | (j[:, 0] == n - 1), (i[:, 0] == 0) | (i[:, 0] == n - 1)
+        )
+        return ~on_border
+    raise InvalidDesignError("centre", f"must be 'central_cells' or 'interior'; got {centre!r}")
+
+
+def _modes(pattern: Pattern, n: int, edges: IntArray, centre: str) -> tuple[str, ...]:
+    m = len(edges)
+    if isinstance(pattern, str):
+        if pattern in MODES:
+            return (pattern,) * m
+        if pattern in ("dome", "saddle"):
+            inner = "expanding" if pattern == "dome" else "contracting"
+            outer = "contracting" if pattern == "dome" else "expanding"
+            return tuple(inner if c else outer for c in _central(n, edges, centre))
+        raise InvalidDesignError(
+            "pattern",
+            f"must be one of {PATTERNS}, a list of {m} modes or a per-edge map; got {pattern!r}",
+        )
+    if isinstance(pattern, Mapping):
+        index = {(int(a), int(b)): e for e, (a, b) in enumerate(edges)}
+        out: list[str | None] = [None] * m
+        for key, mode in pattern.items():
+            if isinstance(key, tuple):
+                e = index.get((min(key), max(key)))
+                if e is None:
+                    raise InvalidDesignError("pattern", f"{key} is not a lattice edge")
+            else:
+                e = int(key)
+                if not 0 <= e < m:
+                    raise InvalidDesignError("pattern", f"edge {e} outside [0, {m - 1}]")
+            out[e] = mode
+        if None in out:
+            raise InvalidDesignError(
+                "pattern", f"per-edge map misses edge {out.index(None)}; give all {m} edges"
+            )
+        pattern = out  # type: ignore[assignment]
+    modes = tuple(pattern)  # type: ignore[arg-type]
+    if len(modes) != m:
+        raise InvalidDesignError(
+            "pattern", f"needs one mode per lattice edge ({m}); got {len(modes)}"
+        )
+    for e, mode in enumerate(modes):
+        if mode not in MODES:
+            raise InvalidDesignError(f"pattern[{e}]", f"must be one of {MODES}; got {mode!r}")
+    return modes
+
+
+@dataclass(frozen=True, eq=False)
+class Lattice:
+    """A sinusoidal lattice: network, per-edge chains and modes, printing parameters.
+
+    Build it with :func:`sinusoidal_lattice`; see the module docstring for the numbering.
+
+    Attributes
+    ----------
+    network
+        Nodes (mm), segments and branch flags (the first ``n²`` nodes).
+    n, spacing, amplitude, ghost_nodes
+        Grid size, node spacing l (mm), sine amplitude A (mm), ghost nodes per edge n_g.
+    edge_nodes
+        ``(E, 2)`` start and end branch node of each lattice edge.
+    edge_chains
+        One array per lattice edge: node indices start branch → ghosts → end branch.
+    edge_mode
+        ``'expanding'`` or ``'contracting'`` per lattice edge.
+    layers, layer_height
+        Number of printed layers and their spacing in z (mm).
+    speed, radius, active_fraction, active_material, passive_material
+        Printing parameters of every filament (mm/s, mm, –, names).
+    """
+
+    network: Network
+    n: int
+    spacing: float
+    amplitude: float
+    ghost_nodes: int
+    edge_nodes: IntArray
+    edge_chains: tuple[IntArray, ...]
+    edge_mode: tuple[str, ...]
+    layers: int = 3
+    layer_height: float = 0.6
+    speed: float = 3.0
+    radius: float = 0.3
+    active_fraction: float = 0.5
+    active_material: str = "lce"
+    passive_material: str = "acrylate"
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    # ----------------------------------------------------------------- branch nodes
+    @property
+    def branch_indices(self) -> IntArray:
+        """Indices of the ``n²`` branch nodes (``0 .. n²-1``)."""
+        return np.flatnonzero(self.network.branch)
+
+    @property
+    def branch_positions(self) -> FloatArray:
+        """Branch node positions ``(n², 3)`` (mm)."""
+        return self.network.nodes[self.branch_indices]
+
+    def branch_index(self, i: int, j: int) -> int:
+        """Node index of the branch node at grid position ``(i, j)``, at ``(l i, l j)``."""
+        if not (0 <= i < self.n and 0 <= j < self.n):
+            raise InvalidDesignError("(i, j)", f"must lie in [0, {self.n - 1}]²; got {(i, j)}")
+        return self.n * i + j
+
+    @property
+    def n_junction_pairs(self) -> int:
+        """Number of segment pairs at branch nodes, Σ deg(deg-1)/2 (94 for n = 5)."""
+        d = self.network.degree[self.network.branch]
+        return int(np.sum(d * (d - 1) // 2))
+
+    @property
+    def edge_direction(self) -> tuple[str, ...]:
+        """``'x'`` or ``'y'`` per lattice edge."""
+        e = self.edge_nodes
+        return tuple("y" if b - a == 1 else "x" for a, b in e)
+
+    # ----------------------------------------------------------------- printing
+    def _lines(self) -> list[list[int]]:
+        """Lattice edges grouped into continuous filaments: x-lines by j, then y-lines by i."""
+        m = self.n - 1
+        nx = self.n * m
+        return [list(range(j * m, (j + 1) * m)) for j in range(self.n)] + [
+            list(range(nx + i * m, nx + (i + 1) * m)) for i in range(self.n)
+        ]
+
+    def _edge_points(self, e: int, subdivide: int) -> FloatArray:
+        """Points of lattice edge ``e`` at ghost parameter s = 0, 1/k, ..., n_g+1 (mm)."""
+        a, b = self.edge_nodes[e]
+        start = self.network.nodes[a]
+        t = (self.network.nodes[b] - start) / self.spacing
+        nrm = np.cross([0.0, 0.0, 1.0], t)
+        per = self.ghost_nodes + 1
+        s = np.arange(per * subdivide + 1) / subdivide
+        return (
+            start
+            + np.outer(s * self.spacing / per, t)
+            + np.outer(self.amplitude * np.sin(2 * np.pi * s / per), nrm)
+        )
+
+    def print_programs(self, subdivide: int = 4) -> list[PrintProgram]:
+        """One :class:`PrintProgram` per line and layer (``2 n · layers``), layer by layer.
+
+        Parameters
+        ----------
+        subdivide
+            Toolpath vertices per network segment (>= 1): the program follows the paper's sine
+            formula at ghost parameter steps 1/subdivide, so every network node is a program
+            vertex (index ``subdivide * m`` along the line) and the nozzle flips over one short
+            toolpath edge rather than a whole network segment.
+
+        Notes
+        -----
+        Each line's nozzle keeps the active half outer (expanding edges) or inner (contracting
+        edges) of the local curvature, flipping by π at inflections (notes Q6, see
+        :meth:`PrintProgram.sinusoid_with_active_side`); layer ``k`` lies at
+        ``z = k * layer_height`` (mm). Lines are printed x-lines (by j) then y-lines (by i), each
+        in +x / +y.
+        """
+        if int(subdivide) != subdivide or subdivide < 1:
+            raise InvalidDesignError("subdivide", f"must be an integer >= 1; got {subdivide}")
+        key = ("programs", int(subdivide))
+        if key not in self._cache:
+            base = []
+            for line in self._lines():
+                pieces = [self._edge_points(line[0], subdivide)[:1]]
+                side = [1.0 if self.edge_mode[line[0]] == "expanding" else -1.0]
+                for e in line:
+                    pts = self._edge_points(e, subdivide)[1:]
+                    pieces.append(pts)
+                    sgn = 1.0 if self.edge_mode[e] == "expanding" else -1.0
+                    side.extend([sgn] * len(pts))
+                path = Path(np.concatenate(pieces))
+                alpha = active_side_angle(path, np.array(side))
+                base.append(
+                    PrintProgram.from_interface_angle(
+                        path,
+                        self.speed,
+                        alpha,
+                        radius=self.radius,
+                        active_fraction=self.active_fraction,
+                        active_material=self.active_material,
+                        passive_material=self.passive_material,
+                    )
+                )
+            self._cache[key] = [
+                p.with_layer(k, k * self.layer_height) for k in range(self.layers) for p in base
+            ]
+        return list(self._cache[key])
+
+    @property
+    def segment_side(self) -> IntArray:
+        """Active side per network segment ``(n_segments,)``: +1 on the left of the segment's
+        direction (−d2), −1 on the right, 0 where the flip falls inside the segment.
+
+        From the sign of the sine's printed curvature at the segment's midpoint parameter
+        s + ½ (left turn > 0) times +1 (expanding, active outer) or −1 (contracting, inner);
+        with an even ``ghost_nodes`` the mid-edge inflection lies inside one segment (0).
+        """
+        per = self.ghost_nodes + 1
+        sine = np.sin(2 * np.pi * (np.arange(per) + 0.5) / per)
+        # curvature of A sin along N = z x T (left) is -A k² sin: left turn where sin < 0
+        turn = np.where(np.abs(sine) < 1e-9, 0.0, -np.sign(sine))
+        if self.amplitude == 0:
+            turn[:] = 0.0
+        out = []
+        for mode in self.edge_mode:
+            outer = 1.0 if mode == "expanding" else -1.0
+            # active outer of a left turn = right side = -1
+            out.append(-outer * turn)
+        return np.concatenate(out).astype(np.int64)
+
+    @property
+    def interface_angle(self) -> FloatArray:
+        """Design interface angle α per network segment ``(n_segments,)`` (rad).
+
+        α = −π/2 (active on the left, n = −d2), +π/2 (right) or 0 on a segment that contains
+        the flip (n = d1 = +z, midway through the π rotation); convention of
+        :mod:`rotomorph.design.program`. The flip at a branch node is a step at the node.
+        """
+        return -0.5 * np.pi * self.segment_side.astype(float)
+
+    @property
+    def segment_mode(self) -> tuple[str, ...]:
+        """Mode of each network segment (its lattice edge's mode)."""
+        per = self.ghost_nodes + 1
+        return tuple(m for m in self.edge_mode for _ in range(per))
+
+
+def sinusoidal_lattice(
+    n: int = 5,
+    spacing: float = 5.0,
+    amplitude: float = 1.25,
+    ghost_nodes: int = 10,
+    pattern: Pattern = "expanding",
+    *,
+    centre: Centre = "central_cells",
+    layers: int = 3,
+    layer_height: float = 0.6,
+    speed: float = 3.0,
+    radius: float = 0.3,
+    active_fraction: float = 0.5,
+    active_material: str = "lce",
+    passive_material: str = "acrylate",
+) -> Lattice:
+    """The paper's n × n lattice of one-period sinusoidal edges (module docstring).
+
+    Parameters
+    ----------
+    n
+        Branch nodes per side (>= 2); the paper uses 5 (25 nodes, 40 edges).
+    spacing
+        Node spacing l (mm), > 0. Not given in the paper (notes Q5); default 5 mm.
+    amplitude
+        Sine amplitude A (mm), >= 0 (0 gives straight edges); default 1.25 mm (A/l = 0.25, Q5).
+    ghost_nodes
+        Ghost nodes per edge n_g (>= 1); paper: 10 (425 nodes in all for n = 5).
+    pattern
+        ``'expanding'``, ``'contracting'``, ``'dome'`` (expanding centre, contracting rest),
+        ``'saddle'`` (the inverse), a sequence of one mode per lattice edge, or a map from edge
+        index or branch-node pair ``(a, b)`` to mode.
+    centre
+        Which edges are "central" for dome/saddle (notes Q12): ``'central_cells'`` (default; both
+        end nodes off the perimeter, 12 edges for n = 5) or ``'interior'`` (every edge not on
+        the perimeter, 24 edges).
+    layers, layer_height
+        Printed layers (paper: 3) and their z spacing (mm).
+    speed, radius, active_fraction, active_material, passive_material
+        Printing parameters: v (mm/s), R (mm), active area fraction, material names.
+
+    Raises
+    ------
+    InvalidDesignError
+        Any parameter out of range, an unknown pattern or mode.
+    """
+    if int(n) != n or n < 2:
+        raise InvalidDesignError("n", f"must be an integer >= 2; got {n}")
+    if int(ghost_nodes) != ghost_nodes or ghost_nodes < 1:
+        raise InvalidDesignError("ghost_nodes", f"must be an integer >= 1; got {ghost_nodes}")
+    if int(layers) != layers or layers < 1:
+        raise InvalidDesignError("layers", f"must be an integer >= 1; got {layers}")
+    for name, value, lo in (
+        ("spacing", spacing, 0.0),
+        ("layer_height", layer_height, 0.0),
+        ("speed", speed, 0.0),
+        ("radius", radius, 0.0),
+    ):
+        if not (np.isfinite(value) and value > lo):
+            raise InvalidDesignError(name, f"must be > 0 (mm or mm/s); got {value}")
+    if not (np.isfinite(amplitude) and amplitude >= 0):
+        raise InvalidDesignError("amplitude", f"must be >= 0 mm; got {amplitude}")
+    n, ghost_nodes, layers = int(n), int(ghost_nodes), int(layers)
+    edges = _edge_list(n)
+    modes = _modes(pattern, n, edges, centre)
+    ii, jj = np.divmod(np.arange(n * n), n)
+    branch_xyz = np.column_stack([spacing * ii, spacing * jj, np.zeros(n * n)])
+    s = np.arange(1, ghost_nodes + 1, dtype=float)
+    per = ghost_nodes + 1
+    ghosts, chains, segs = [], [], []
+    z = np.array([0.0, 0.0, 1.0])
+    for e, (a, b) in enumerate(edges):
+        t = (branch_xyz[b] - branch_xyz[a]) / spacing
+        nrm = np.cross(z, t)  # N = z x T on every edge (notes 2.7, Q8)
+        ghosts.append(
+            branch_xyz[a]
+            + np.outer(s * spacing / per, t)
+            + np.outer(amplitude * np.sin(2 * np.pi * s / per), nrm)
+        )
+        chain = np.concatenate([[a], n * n + e * ghost_nodes + np.arange(ghost_nodes), [b]])
+        chain.setflags(write=False)
+        chains.append(chain)
+        segs.append(np.column_stack([chain[:-1], chain[1:]]))
+    nodes = np.concatenate([branch_xyz, *ghosts])
+    branch = np.zeros(len(nodes), dtype=bool)
+    branch[: n * n] = True
+    network = Network(nodes, np.concatenate(segs), branch)
+    edges.setflags(write=False)
+    return Lattice(
+        network,
+        n,
+        float(spacing),
+        float(amplitude),
+        ghost_nodes,
+        edges,
+        tuple(chains),
+        modes,
+        layers,
+        float(layer_height),
+        float(speed),
+        float(radius),
+        float(active_fraction),
+        active_material,
+        passive_material,
+    )

@@ -1,0 +1,360 @@
+r"""Print programs: what the printer does along ONE filament (path, speed, nozzle angle).
+
+Symbols (paper, "Rotational multimaterial 3D printing"; physics notes 1.1):
+
+==================  ==========================================================================
+``speed`` v         print (translation) speed at each vertex (mm/s); the move that *leaves*
+                    vertex i runs at ``speed[i]`` (the last value repeats the last move's)
+``nozzle_angle``    :math:`\alpha_n`, lab angle of the interface normal n toward the active
+                    channel, counter-clockwise from +x seen from above (rad), cumulative
+                    (unwrapped): this is what the rotary axis commands
+``rotation`` ω      :math:`v\,d\alpha_n/ds` (rad/s) at each vertex
+``interface_angle`` :math:`\alpha`, the angle of n in the filament cross-section, measured from
+                    :math:`d_1` (= :func:`rotomorph.geometry.space_parallel_directors`, i.e.
+                    :math:`+\hat z` for a path in the xy-plane) toward :math:`d_2 = t\times d_1`
+``ω*``              rotation number :math:`R\omega/v` (paper eq. for ω*, notes Q1: R = filament
+                    radius)
+==================  ==========================================================================
+
+Interface angle convention (notes 1.1, [DERIVED + ASSUMPTION]): the extrudate leaves the nozzle
+flowing along :math:`-\hat z` and is laid down along the path tangent t by the rigid rotation
+(about :math:`-\hat z\times t`) that takes :math:`-\hat z` to t. The nozzle's in-plane normal
+:math:`(\cos\alpha_n, \sin\alpha_n, 0)` is carried along, which gives, for a planar path with
+heading ψ,
+
+.. math:: \alpha = \psi - \alpha_n ,
+
+exactly (constant = 0), so a straight path printed with a rotating nozzle has
+:math:`d\alpha/ds = -\omega/v` (:math:`|d\alpha/ds| = \omega/v`, paper), and a fixed nozzle on a
+curved path still turns the interface by the heading change. ``interface_angle`` is reported per
+edge at the edge's midpoint: the rotary axis moves linearly between vertices, so the edge sees
+the mean of its two vertex nozzle angles. With this convention n = -d2 (α = -π/2) is the *left*
+side of the path (the inner side of a left turn).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal, Union
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.design.path import Path
+from rotomorph.errors import InvalidDesignError
+from rotomorph.geometry import signed_angle, space_parallel_directors
+
+__all__ = ["PrintProgram", "Profile"]
+
+#: A per-vertex quantity: a scalar, an ``(N,)`` array, or a function of arc length s (mm).
+Profile = Union[float, FloatArray, Callable[[FloatArray], FloatArray]]  # noqa: UP007
+
+_ZERO_CURVATURE = 1e-9  # 1/mm: below this a vertex counts as an inflection point
+
+
+def _per_vertex(name: str, value: Profile, s: FloatArray) -> FloatArray:
+    out = value(s) if callable(value) else value
+    arr = np.broadcast_to(np.asarray(out, dtype=float), s.shape) if np.ndim(out) == 0 else out
+    arr = np.array(arr, dtype=float)
+    if arr.shape != s.shape:
+        raise InvalidDesignError(
+            name,
+            f"must be a scalar, a function of s or have one value per vertex {s.shape}; "
+            f"got shape {arr.shape}",
+        )
+    return arr
+
+
+def _as_points(path: Path | FloatArray) -> FloatArray:
+    return path.points if isinstance(path, Path) else Path(path).points
+
+
+def _interface_normals(points: FloatArray, nozzle_angle_edge: FloatArray) -> FloatArray:
+    """Lab-frame interface normals ``(N-1, 3)`` of the extrudate on each edge (module notes)."""
+    e = np.diff(points, axis=0)
+    t = e / np.linalg.norm(e, axis=1)[:, None]
+    m = np.column_stack(
+        [np.cos(nozzle_angle_edge), np.sin(nozzle_angle_edge), np.zeros_like(nozzle_angle_edge)]
+    )
+    # rotation taking a = -z to t (Rodrigues); undefined only for t = +z (printing upward)
+    a = np.array([0.0, 0.0, -1.0])
+    axis = np.cross(a, t)
+    sin = np.linalg.norm(axis, axis=1)
+    cos = t @ a
+    k = np.where(sin[:, None] > 1e-12, axis / np.maximum(sin, 1e-300)[:, None], [1.0, 0.0, 0.0])
+    kxm = np.cross(k, m)
+    kdm = np.einsum("ij,ij->i", k, m)
+    return m * cos[:, None] + kxm * sin[:, None] + k * (kdm * (1 - cos))[:, None]
+
+
+@dataclass(frozen=True, eq=False)
+class PrintProgram:
+    """What the printer does along one filament.
+
+    Parameters
+    ----------
+    points
+        Nozzle-tip vertices ``(N, 3)`` (mm), ``N >= 2``.
+    speed
+        Print speed per vertex ``(N,)`` (mm/s), > 0 (a scalar broadcasts).
+    nozzle_angle
+        Lab nozzle angle :math:`\\alpha_n` per vertex ``(N,)`` (rad), cumulative (see module).
+    radius
+        Filament radius R (mm), > 0; default 0.3 (paper: ~600 µm diameter).
+    active_fraction
+        Area fraction of the active ink in the cross-section, in [0, 1]; default 0.5.
+    active_material, passive_material
+        Material names (default ``"lce"``, ``"acrylate"``).
+    layer
+        Layer index (>= 0).
+
+    Raises
+    ------
+    InvalidDesignError
+        Shapes, non-finite values, ``speed <= 0`` (with the vertex index), out-of-range scalars.
+    """
+
+    points: FloatArray
+    speed: FloatArray
+    nozzle_angle: FloatArray
+    radius: float = 0.3
+    active_fraction: float = 0.5
+    active_material: str = "lce"
+    passive_material: str = "acrylate"
+    layer: int = 0
+
+    def __post_init__(self) -> None:
+        pts = Path(self.points).points.copy()
+        n = len(pts)
+        arrays = {}
+        for name in ("speed", "nozzle_angle"):
+            raw = np.asarray(getattr(self, name), dtype=float)
+            arr = np.array(np.broadcast_to(raw, (n,)) if raw.ndim == 0 else raw, dtype=float)
+            if arr.shape != (n,):
+                raise InvalidDesignError(
+                    f"PrintProgram.{name}", f"must have one value per vertex ({n}); got {arr.shape}"
+                )
+            bad = ~np.isfinite(arr)
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                raise InvalidDesignError(
+                    f"PrintProgram.{name}", f"must be finite; got {arr[i]} at vertex {i}"
+                )
+            arrays[name] = arr
+        slow = arrays["speed"] <= 0
+        if slow.any():
+            i = int(np.flatnonzero(slow)[0])
+            raise InvalidDesignError(
+                "PrintProgram.speed", f"must be > 0 mm/s; got {arrays['speed'][i]} at vertex {i}"
+            )
+        if not (np.isfinite(self.radius) and self.radius > 0):
+            raise InvalidDesignError("PrintProgram.radius", f"must be > 0 mm; got {self.radius}")
+        if not (0.0 <= self.active_fraction <= 1.0):
+            raise InvalidDesignError(
+                "PrintProgram.active_fraction", f"must lie in [0, 1]; got {self.active_fraction}"
+            )
+        for name in ("active_material", "passive_material"):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise InvalidDesignError(f"PrintProgram.{name}", "must be a non-empty name")
+        if int(self.layer) != self.layer or self.layer < 0:
+            raise InvalidDesignError(
+                "PrintProgram.layer", f"must be an integer >= 0; got {self.layer}"
+            )
+        for name, value in (("points", pts), *arrays.items()):
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "radius", float(self.radius))
+        object.__setattr__(self, "active_fraction", float(self.active_fraction))
+        object.__setattr__(self, "layer", int(self.layer))
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def path(self) -> Path:
+        """The print path."""
+        return Path(self.points)
+
+    @property
+    def arc_length(self) -> FloatArray:
+        """Arc length at each vertex ``(N,)`` (mm)."""
+        return self.path.arc_length
+
+    @property
+    def rotation(self) -> FloatArray:
+        """Nozzle rotation rate ω = v dα_n/ds per vertex ``(N,)`` (rad/s)."""
+        s = self.arc_length
+        return self.speed * np.gradient(self.nozzle_angle, s)
+
+    def rotation_number(self) -> FloatArray:
+        """Dimensionless rotation rate ω* = Rω/v = R dα_n/ds per vertex ``(N,)``."""
+        return self.radius * np.gradient(self.nozzle_angle, self.arc_length)
+
+    @property
+    def interface_normals(self) -> FloatArray:
+        """Unit interface normals toward the active half, per edge ``(N-1, 3)`` (lab frame)."""
+        mid = 0.5 * (self.nozzle_angle[1:] + self.nozzle_angle[:-1])
+        return _interface_normals(self.points, mid)
+
+    @property
+    def interface_angle(self) -> FloatArray:
+        """Interface angle α per edge ``(N-1,)`` (rad), from d1 toward d2 = t × d1 (module).
+
+        Unwrapped along the filament; for a planar path exactly ``ψ - mean(α_n)`` per edge.
+        """
+        pts = self.points
+        t = np.diff(pts, axis=0)
+        t /= np.linalg.norm(t, axis=1)[:, None]
+        d1 = space_parallel_directors(pts)
+        alpha = np.unwrap(signed_angle(d1, self.interface_normals, t))
+        mid = 0.5 * (self.nozzle_angle[1:] + self.nozzle_angle[:-1])
+        ref = self.path.heading[0] - mid[0]
+        return alpha + 2 * np.pi * np.round((ref - alpha[0]) / (2 * np.pi))
+
+    @property
+    def duration(self) -> float:
+        """Print time along the path (s), each edge at the speed of its start vertex."""
+        return float(np.sum(self.path.edge_lengths / self.speed[:-1]))
+
+    def with_layer(self, layer: int, z: float | None = None) -> PrintProgram:
+        """The same program on ``layer``, optionally moved to height ``z`` (mm)."""
+        pts = self.points.copy()
+        if z is not None:
+            pts[:, 2] = z
+        return PrintProgram(
+            pts,
+            self.speed,
+            self.nozzle_angle,
+            self.radius,
+            self.active_fraction,
+            self.active_material,
+            self.passive_material,
+            layer,
+        )
+
+    def translated(self, offset: FloatArray | tuple[float, float, float]) -> PrintProgram:
+        """The same program moved by ``offset`` (mm, length 3); angles are unchanged."""
+        pts = self.points + np.asarray(offset, dtype=float).reshape(3)
+        return PrintProgram(
+            pts,
+            self.speed,
+            self.nozzle_angle,
+            self.radius,
+            self.active_fraction,
+            self.active_material,
+            self.passive_material,
+            self.layer,
+        )
+
+    # ----------------------------------------------------------------- constructors
+    @classmethod
+    def from_rotation(
+        cls,
+        path: Path | FloatArray,
+        speed: Profile,
+        rotation: Profile = 0.0,
+        *,
+        initial_angle: float = 0.0,
+        **kwargs: object,
+    ) -> PrintProgram:
+        """Program with a prescribed nozzle rotation rate ω(s).
+
+        Parameters
+        ----------
+        path
+            :class:`Path` or vertices ``(N, 3)`` (mm).
+        speed
+            v (mm/s): scalar, ``(N,)`` or a function of arc length s (mm).
+        rotation
+            ω (rad/s): scalar, ``(N,)`` or a function of s. The nozzle angle is
+            :math:`\\alpha_n(s) = \\alpha_n(0) + \\int_0^s \\omega/v\\,ds` (trapezoid rule,
+            exact for constant ω/v).
+        initial_angle
+            :math:`\\alpha_n(0)` (rad).
+        **kwargs
+            ``radius``, ``active_fraction``, ``active_material``, ``passive_material``, ``layer``.
+        """
+        pts = _as_points(path)
+        s = Path(pts).arc_length
+        v = _per_vertex("speed", speed, s)
+        w = _per_vertex("rotation", rotation, s)
+        if (v <= 0).any():
+            i = int(np.flatnonzero(v <= 0)[0])
+            raise InvalidDesignError("speed", f"must be > 0 mm/s; got {v[i]} at vertex {i}")
+        rate = w / v
+        angle = initial_angle + np.concatenate(
+            [[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(s))]
+        )
+        return cls(pts, v, angle, **kwargs)  # type: ignore[arg-type]
+
+    @classmethod
+    def from_interface_angle(
+        cls,
+        path: Path | FloatArray,
+        speed: Profile,
+        interface_angle: Profile,
+        **kwargs: object,
+    ) -> PrintProgram:
+        """Program whose filament gets the interface angle α(s) (rad), for a planar path.
+
+        ``interface_angle`` is given per vertex (scalar, ``(N,)`` or a function of s in mm) and
+        the nozzle follows :math:`\\alpha_n = \\psi_v - \\alpha` with :math:`\\psi_v` the vertex
+        heading (mean of the adjacent edges' headings). The per-edge :attr:`interface_angle` of
+        the result is then the edge mean of the vertex values up to O(h²) in curvature changes.
+        """
+        pts = _as_points(path)
+        p = Path(pts)
+        alpha = _per_vertex("interface_angle", interface_angle, p.arc_length)
+        v = _per_vertex("speed", speed, p.arc_length)
+        return cls(pts, v, _vertex_heading(p) - alpha, **kwargs)  # type: ignore[arg-type]
+
+    @classmethod
+    def sinusoid_with_active_side(
+        cls,
+        path: Path | FloatArray,
+        speed: Profile,
+        side: Literal["outer", "inner"] = "outer",
+        **kwargs: object,
+    ) -> PrintProgram:
+        """Keep the active half on the in-plane outer (or inner) side of the path's curvature.
+
+        Notes Q6: α = +π/2·sign κ (outer) or −π/2·sign κ (inner) at each vertex, so the nozzle
+        tracks the heading and flips by π at inflections; a vertex with zero curvature
+        (|κ| < 1e-9 /mm, e.g. a lattice branch node) gets α = 0, splitting the flip over its two
+        edges. Works for any planar path (sinusoid, lattice line, arc).
+
+        Parameters
+        ----------
+        path
+            :class:`Path` or vertices ``(N, 3)`` in a horizontal plane (mm).
+        speed
+            v (mm/s): scalar, ``(N,)`` or a function of s.
+        side
+            ``"outer"`` (active on the convex side: straightening/expanding) or ``"inner"``
+            (curling/contracting) [PAPER].
+        """
+        return cls.from_interface_angle(path, speed, active_side_angle(path, side), **kwargs)
+
+
+def _vertex_heading(path: Path) -> FloatArray:
+    h = path.heading
+    inner = 0.5 * (h[1:] + h[:-1])
+    return np.concatenate([[h[0]], inner, [h[-1]]])
+
+
+def active_side_angle(path: Path | FloatArray, side: str | FloatArray = "outer") -> FloatArray:
+    """Per-vertex interface angle (rad) putting the active half outer/inner (see above).
+
+    ``side`` may also be an ``(N,)`` array of +1 (outer) / -1 (inner) per vertex.
+    """
+    p = path if isinstance(path, Path) else Path(path)
+    if isinstance(side, str):
+        if side not in ("outer", "inner"):
+            raise InvalidDesignError("side", f"must be 'outer' or 'inner'; got {side!r}")
+        sgn = np.full(p.n_vertices, 1.0 if side == "outer" else -1.0)
+    else:
+        sgn = np.asarray(side, dtype=float)
+    kappa = p.curvature
+    sign = np.where(np.abs(kappa) < _ZERO_CURVATURE, 0.0, np.sign(kappa))
+    if len(sign) > 2:  # the end vertices have no turning angle: continue the neighbour's side
+        sign[0], sign[-1] = sign[1], sign[-2]
+    return sgn * sign * (np.pi / 2)
