@@ -96,3 +96,15 @@ def test_missing_chain_and_bad_grid_raise(lattice):
         lattice_boundary_loop(chains[1:], 5)
     with pytest.raises(InvalidParameterError, match="n"):
         lattice_boundary_loop(chains, 1)
+
+
+def test_with_the_design_layers_lattice():
+    from rotomorph.design.lattices import sinusoidal_lattice as design_lattice
+
+    lat = design_lattice(n=5, spacing=5.0, amplitude=1.25)
+    pos = lat.network.nodes
+    loop = lattice_boundary_loop(lat.edge_chains, 5)
+    assert len(loop) == 16 * 11
+    assert loop_area(pos, loop) == pytest.approx(400.0, rel=1e-12)
+    np.testing.assert_allclose(unit_apertures(pos, lat.edge_chains, 5), 25.0, rtol=1e-12)
+    assert normalized_area(pos * 1.3, pos, loop) == pytest.approx(1.69)
