@@ -27,6 +27,7 @@ curvature and twist in 1/mm.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from rotomorph._typing import FloatArray
 
@@ -115,19 +116,39 @@ def space_parallel_directors(points: FloatArray, first: FloatArray | None = None
     ndarray
         Unit directors ``(N-1, 3)``, each perpendicular to its edge.
     """
-    t = unit(np.diff(points, axis=0))
+    t = unit(np.diff(np.asarray(points, dtype=float), axis=0))
     if first is None:
         first = np.array([0.0, 0.0, 1.0]) if abs(t[0, 2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     d = np.asarray(first, dtype=float) - _dot(first, t[0]) * t[0]
-    d = d / np.linalg.norm(d)
     out = np.empty_like(t)
-    out[0] = d
-    for i in range(1, len(t)):
-        d = parallel_transport(d, t[i - 1], t[i])
-        d = d - _dot(d, t[i]) * t[i]
-        d = d / np.linalg.norm(d)
-        out[i] = d
+    _transport_chain(t, d / np.linalg.norm(d), out)
     return out
+
+
+@njit(cache=True)
+def _transport_chain(t, d0, out):  # pragma: no cover - compiled
+    """Sequential parallel transport of ``d0`` along the tangents ``t`` (see above)."""
+    out[0] = d0
+    for i in range(1, t.shape[0]):
+        a = t[i - 1]
+        b = t[i]
+        u = out[i - 1]
+        bx = a[1] * b[2] - a[2] * b[1]
+        by = a[2] * b[0] - a[0] * b[2]
+        bz = a[0] * b[1] - a[1] * b[0]
+        s = np.sqrt(bx * bx + by * by + bz * bz)
+        if s < _PARALLEL_TOL:
+            v = u.copy()
+        else:
+            bx, by, bz = bx / s, by / s, bz / s
+            n1 = np.array([a[1] * bz - a[2] * by, a[2] * bx - a[0] * bz, a[0] * by - a[1] * bx])
+            n2 = np.array([b[1] * bz - b[2] * by, b[2] * bx - b[0] * bz, b[0] * by - b[1] * bx])
+            ua = u[0] * a[0] + u[1] * a[1] + u[2] * a[2]
+            un = u[0] * n1[0] + u[1] * n1[1] + u[2] * n1[2]
+            ub = u[0] * bx + u[1] * by + u[2] * bz
+            v = ua * b + un * n2 + ub * np.array([bx, by, bz])
+        v = v - (v[0] * b[0] + v[1] * b[1] + v[2] * b[2]) * b
+        out[i] = v / np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 
 
 def rotate_about_tangent(d1: FloatArray, t: FloatArray, angle: FloatArray) -> FloatArray:

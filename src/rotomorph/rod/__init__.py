@@ -1,0 +1,1 @@
+"""Rod layer: discrete elastic rod (DER) model of filaments and rod networks."""

@@ -1,0 +1,221 @@
+"""The discrete elastic rod model of a filament or a rod network.
+
+One model serves both: a single filament is a network with one chain. Per-edge section
+properties (bending stiffnesses ``B1`` toward the material director ``m1`` and ``B2`` toward
+``m2``, twist stiffness ``C``, axial stiffness ``EA``) and per-stencil natural curvature and twist
+are arrays fixed at construction; transforms return new models (:meth:`Model.with_natural`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.design.network import Network
+from rotomorph.errors import InvalidParameterError
+from rotomorph.geometry import pair_strains, space_parallel_directors
+from rotomorph.rod.assembly import reference_twist
+from rotomorph.rod.state import State
+from rotomorph.rod.stencils import DofLayout, Stencils, build_stencils, dof_layout
+
+
+def _per_item(name: str, value: object, n: int, positive: bool) -> FloatArray:
+    arr = np.array(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        raise InvalidParameterError(
+            f"Model.{name}", f"must be a scalar or have shape ({n},); got {arr.shape}"
+        )
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        raise InvalidParameterError(
+            f"Model.{name}", f"must be finite; entry {int(np.flatnonzero(bad)[0])} is not"
+        )
+    if positive and (arr <= 0).any():
+        i = int(np.flatnonzero(arr <= 0)[0])
+        raise InvalidParameterError(f"Model.{name}", f"must be > 0; got {arr[i]} at entry {i}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _default_directors(network: Network) -> FloatArray:
+    deg = network.degree
+    e = network.edges
+    is_chain = (
+        not network.branch.any()
+        and deg.max() <= 2
+        and np.array_equal(e, np.stack([np.arange(len(e)), np.arange(1, len(e) + 1)], axis=1))
+    )
+    if is_chain:
+        return space_parallel_directors(network.nodes)
+    t = network.nodes[e[:, 1]] - network.nodes[e[:, 0]]
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    ref = np.where(np.abs(t[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    d = ref - np.sum(ref * t, axis=1, keepdims=True) * t
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Discrete elastic rod model of a network (units: mm, N, MPa).
+
+    Parameters
+    ----------
+    network
+        Reference (printed) geometry and topology.
+    bending_stiffness1, bending_stiffness2
+        Per-edge bending stiffnesses ``B1`` (bending toward ``m1``) and ``B2`` (toward ``m2``),
+        N mm²; scalars broadcast.
+    twist_stiffness
+        Per-edge torsional stiffness ``C`` (N mm²).
+    axial_stiffness
+        Per-edge axial stiffness ``EA`` (N); large values make the rod nearly inextensible.
+    directors
+        Per-edge material director ``m1`` in the reference configuration ``(E, 3)``; projected
+        perpendicular to its edge and normalised. For a Janus filament, the interface normal
+        pointing into the active half. Default: space-parallel (twist-free) frames for a chain,
+        ``+z`` projected on each edge otherwise.
+    natural_curvature1, natural_curvature2, natural_twist
+        Per-stencil natural curvature toward ``m1``, toward ``m2`` and natural twist (1/mm,
+        pointwise values; multiplied internally by the Voronoi length of rest lengths).
+        Default: those of the reference configuration (stress-free as printed).
+    rest_length
+        Per-edge natural length (mm). Default: reference lengths.
+
+    Notes
+    -----
+    Junction (branch-node pair) stencils use the isotropic mean ``(B1+B2)/2`` of both edges,
+    since the anisotropy axes of two crossing filaments need not align (physics notes, Q14).
+    """
+
+    network: Network
+    bending_stiffness1: FloatArray | float
+    bending_stiffness2: FloatArray | float
+    twist_stiffness: FloatArray | float
+    axial_stiffness: FloatArray | float
+    directors: FloatArray | None = None
+    natural_curvature1: FloatArray | None = None
+    natural_curvature2: FloatArray | None = None
+    natural_twist: FloatArray | None = None
+    rest_length: FloatArray | None = None
+    stencils: Stencils = field(init=False, repr=False)
+    layout: DofLayout = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        net = self.network
+        ne = net.n_edges
+        set_ = object.__setattr__
+        for name in ("bending_stiffness1", "bending_stiffness2", "twist_stiffness",
+                     "axial_stiffness"):
+            set_(self, name, _per_item(name, getattr(self, name), ne, positive=True))
+        st = build_stencils(net)
+        set_(self, "stencils", st)
+        set_(self, "layout", dof_layout(net))
+        t = net.nodes[net.edges[:, 1]] - net.nodes[net.edges[:, 0]]
+        t = t / np.linalg.norm(t, axis=1, keepdims=True)
+        d = _default_directors(net) if self.directors is None else np.array(
+            self.directors, dtype=float)
+        if d.shape != (ne, 3) or not np.isfinite(d).all():
+            raise InvalidParameterError(
+                "Model.directors", f"must be a finite array of shape ({ne}, 3)"
+            )
+        d = d - np.sum(d * t, axis=1, keepdims=True) * t
+        norm = np.linalg.norm(d, axis=1)
+        if (norm < 1e-9).any():
+            raise InvalidParameterError(
+                "Model.directors",
+                f"director {int(np.argmin(norm))} is parallel to its edge; give one across it",
+            )
+        d = d / norm[:, None]
+        d.setflags(write=False)
+        set_(self, "directors", d)
+        rest = net.edge_lengths if self.rest_length is None else self.rest_length
+        set_(self, "rest_length", _per_item("rest_length", rest, ne, positive=True))
+        k1, k2, tw = self._reference_integrated()
+        for name, ref in (("natural_curvature1", k1), ("natural_curvature2", k2),
+                          ("natural_twist", tw)):
+            value = getattr(self, name)
+            if value is None:
+                value = ref / self._reference_voronoi()
+            set_(self, name, _per_item(name, value, st.count, positive=False))
+
+    # ------------------------------------------------------------------ geometry helpers
+    def _reference_voronoi(self) -> FloatArray:
+        lengths = self.network.edge_lengths
+        return 0.5 * (lengths[self.stencils.edge_e] + lengths[self.stencils.edge_f])
+
+    def _reference_integrated(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        st, x = self.stencils, self.network.nodes
+        e = x[st.nodes[:, 1]] - x[st.nodes[:, 0]]
+        f = x[st.nodes[:, 2]] - x[st.nodes[:, 1]]
+        return pair_strains(e, f, self.directors[st.edge_e], self.directors[st.edge_f])
+
+    @property
+    def voronoi_length(self) -> FloatArray:
+        """Per-stencil Voronoi length of rest lengths ``(S,)`` (mm)."""
+        r = self.rest_length
+        return 0.5 * (r[self.stencils.edge_e] + r[self.stencils.edge_f])
+
+    @property
+    def stencil_stiffness(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Per-stencil ``(B1, B2, C)`` (N mm²): edge means; isotropic at junctions."""
+        st = self.stencils
+        b1 = 0.5 * (self.bending_stiffness1[st.edge_e] + self.bending_stiffness1[st.edge_f])
+        b2 = 0.5 * (self.bending_stiffness2[st.edge_e] + self.bending_stiffness2[st.edge_f])
+        c = 0.5 * (self.twist_stiffness[st.edge_e] + self.twist_stiffness[st.edge_f])
+        iso = 0.5 * (b1 + b2)
+        b1 = np.where(st.junction, iso, b1)
+        b2 = np.where(st.junction, iso, b2)
+        return b1, b2, c
+
+    def integrated_natural(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Natural ``(kappa1, kappa2, tau)`` per stencil, integrated (dimensionless)."""
+        v = self.voronoi_length
+        return self.natural_curvature1 * v, self.natural_curvature2 * v, self.natural_twist * v
+
+    def reference_strains(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Pointwise curvatures and twist of the reference configuration (1/mm), per stencil."""
+        k1, k2, tw = self._reference_integrated()
+        v = self._reference_voronoi()
+        return k1 / v, k2 / v, tw / v
+
+    # ------------------------------------------------------------------ transforms
+    def with_natural(
+        self,
+        curvature1: FloatArray | None = None,
+        curvature2: FloatArray | None = None,
+        twist: FloatArray | None = None,
+        rest_length: FloatArray | None = None,
+    ) -> Model:
+        """A copy with new natural curvatures, twist (1/mm, per stencil) or rest lengths (mm).
+
+        Arguments left ``None`` keep their current values.
+        """
+        return replace(
+            self,
+            natural_curvature1=self.natural_curvature1 if curvature1 is None else curvature1,
+            natural_curvature2=self.natural_curvature2 if curvature2 is None else curvature2,
+            natural_twist=self.natural_twist if twist is None else twist,
+            rest_length=self.rest_length if rest_length is None else rest_length,
+        )
+
+    def reference_state(self) -> State:
+        """The printed configuration: reference positions, zero twist angles, set-up frames."""
+        net = self.network
+        x = np.array(net.nodes, dtype=float)
+        t = x[net.edges[:, 1]] - x[net.edges[:, 0]]
+        t /= np.linalg.norm(t, axis=1, keepdims=True)
+        st = self.stencils
+        mref = np.empty(st.count)
+        reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t,
+                        np.array(self.directors), np.zeros(st.count), mref)
+        return State(positions=x, theta=np.zeros(net.n_edges), tangents=t,
+                     directors=np.array(self.directors), reference_twist=mref)
+
+    @classmethod
+    def chain(cls, points: FloatArray, **kwargs: object) -> Model:
+        """A single filament through ``points`` ``(N, 3)`` (mm); keywords as for :class:`Model`."""
+        return cls(Network.chain(points), **kwargs)  # type: ignore[arg-type]

@@ -1,0 +1,1 @@
+"""Solvers: a generic modified-Newton minimiser and static equilibrium of rod networks."""

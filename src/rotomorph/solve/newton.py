@@ -1,0 +1,206 @@
+"""A modified-Newton minimiser with an energy line search, written against an objective.
+
+The solver knows nothing about rods: an :class:`Objective` supplies energy, gradient and
+Hessian as functions of a flat vector, a way to solve with a shifted Hessian, a retraction
+(how a step is applied) and an ``accept`` hook (rods re-base their frames there). The loop is
+the classical one (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 3.2 with the
+"Cholesky with added multiple of the identity" of §3.4, here a diagonal metric ``M``):
+
+1. factor ``H + tau M``, raising ``tau`` until positive definite (so the step is a descent
+   direction and saddle points repel), lowering it again after good steps;
+2. backtracking Armijo line search on the energy (the merit function);
+3. stop when the weighted gradient norm is below ``rtol`` times the force scale, or when a pure
+   Newton step's decrement is below ``decrement_tol`` times the energy scale.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.errors import InvalidParameterError
+from rotomorph.solve.linalg import solve_shifted
+from rotomorph.solve.result import NewtonResult, Status
+
+log = logging.getLogger(__name__)
+
+
+class Objective(Protocol):
+    """What :func:`minimize` needs from a problem."""
+
+    def evaluate(
+        self, x: FloatArray, need_grad: bool, need_hess: bool
+    ) -> tuple[float, FloatArray | None, Any]:
+        """Energy, gradient (or None) and Hessian (or None) at ``x`` relative to the base."""
+
+    def metric(self) -> FloatArray:
+        """Positive diagonal metric ``M`` for the modified-Newton shift."""
+
+    def weights(self) -> FloatArray:
+        """Positive weights making the gradient norm dimensionally consistent."""
+
+    def retract(self, x: FloatArray, d: FloatArray, alpha: float) -> FloatArray:
+        """The point reached from ``x`` by the step ``alpha * d``."""
+
+    def accept(self, x: FloatArray) -> None:
+        """Called with every accepted iterate (re-base frames, etc.)."""
+
+    force_scale: float
+    energy_scale: float
+
+
+@dataclass(frozen=True)
+class NewtonOptions:
+    """Settings of :func:`minimize`.
+
+    Parameters
+    ----------
+    max_iterations
+        Newton iterations allowed; reaching it is reported, never called convergence.
+    rtol
+        Weighted gradient norm relative to the force scale at which to stop.
+    decrement_tol
+        Newton decrement ``-g.d / 2`` relative to the energy scale at which to stop.
+    armijo
+        Sufficient-decrease constant of the line search.
+    max_backtracks
+        Halvings allowed in one line search before the shift is raised.
+    """
+
+    max_iterations: int = 200
+    rtol: float = 1e-9
+    decrement_tol: float = 1e-16
+    armijo: float = 1e-4
+    max_backtracks: int = 40
+
+    def __post_init__(self) -> None:
+        if self.max_iterations < 1:
+            raise InvalidParameterError("NewtonOptions.max_iterations", "must be >= 1")
+        for name in ("rtol", "decrement_tol", "armijo"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InvalidParameterError(f"NewtonOptions.{name}", f"must be > 0; got {v}")
+
+
+def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = None) -> NewtonResult:
+    """Minimise ``obj`` from ``x0`` by modified Newton with a line search.
+
+    Returns a :class:`NewtonResult`; the caller decides whether a non-converged status is an
+    error (the static rod solver raises :class:`rotomorph.errors.ConvergenceError`).
+    """
+    opt = options or NewtonOptions()
+    x = np.array(x0, dtype=float)
+    f, g, H = obj.evaluate(x, True, True)
+    M = obj.metric()
+    w = obj.weights()
+    fscale = max(float(np.linalg.norm(w * g)), obj.force_scale, 1e-300)
+    escale = max(obj.energy_scale, abs(f), 1e-300)
+    diag = H.diagonal if hasattr(H, "u") else np.asarray(H.diagonal())
+    tau_unit = max(float(np.max(np.abs(diag) / M)) if diag.size else 1.0, 1e-300)
+    tau_min = 1e-14 * tau_unit
+    tau = 0.0
+    history: list[tuple[float, float, float, float]] = []
+    n_fact = 0
+    dec = np.inf
+    status = Status.MAX_ITERATIONS
+    it = 0
+    while it < opt.max_iterations:
+        res = float(np.linalg.norm(w * g)) / fscale
+        if not np.isfinite(f) or not np.isfinite(res):
+            status = Status.NOT_FINITE
+            break
+        if res <= opt.rtol:
+            status = Status.CONVERGED
+            break
+        it += 1
+        # modified Newton: smallest shift (from a warm start) giving a positive definite matrix
+        tau = 0.0 if tau <= 1e3 * tau_min else tau / 10.0
+        while True:
+            n_fact += 1
+            d = solve_shifted(H, -g, tau * M)
+            if d is not None and np.all(np.isfinite(d)):
+                break
+            tau = max(10.0 * tau, 1e-8 * tau_unit)
+            if tau > 1e12 * tau_unit:
+                status = Status.NOT_FINITE
+                return _result(x, status, it, n_fact, f, res, dec, history)
+        slope = float(g @ d)
+        dec = -0.5 * slope / escale
+        if tau == 0.0 and dec <= opt.decrement_tol:
+            x = obj.retract(x, d, 1.0)
+            obj.accept(x)
+            f, g, H = obj.evaluate(x, True, True)
+            res = float(np.linalg.norm(w * g)) / fscale
+            history.append((f, res, 1.0, tau))
+            status = Status.CONVERGED
+            return _result(x, status, it, n_fact, f, res, dec, history)
+        alpha = 1.0
+        accepted = False
+        for _ in range(opt.max_backtracks):
+            xt = obj.retract(x, d, alpha)
+            ft = obj.evaluate(xt, False, False)[0]
+            if np.isfinite(ft) and ft <= f + opt.armijo * alpha * slope:
+                accepted = True
+                break
+            # safeguarded quadratic interpolation of the energy along the step
+            denom = 2.0 * (ft - f - alpha * slope)
+            a_q = -slope * alpha * alpha / denom if np.isfinite(ft) and denom > 0 else 0.5 * alpha
+            alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
+        if not accepted:
+            if tau < 1e10 * tau_unit:
+                tau = max(100.0 * tau, 1e-6 * tau_unit)
+                history.append((f, res, 0.0, tau))
+                continue
+            status = Status.LINE_SEARCH_FAILED
+            break
+        x = xt
+        obj.accept(x)
+        f, g, H = obj.evaluate(x, True, True)
+        history.append((f, float(np.linalg.norm(w * g)) / fscale, alpha, tau))
+        log.debug("newton %d: E=%.6e res=%.3e alpha=%.3g tau=%.3g", it, f, history[-1][1],
+                  alpha, tau)
+    res = float(np.linalg.norm(w * g)) / fscale
+    return _result(x, status, it, n_fact, f, res, dec, history)
+
+
+def _result(x, status, it, n_fact, f, res, dec, history) -> NewtonResult:  # type: ignore[no-untyped-def]
+    return NewtonResult(
+        x=x, status=status, iterations=it, factorizations=n_fact, energy=float(f),
+        residual=float(res), decrement=float(dec),
+        history=np.array(history, dtype=float).reshape(-1, 4),
+    )
+
+
+class FunctionObjective:
+    """Adapter for plain callables ``fun(x)``, ``jac(x)``, ``hess(x)`` (dense), e.g. SciPy's
+    ``rosen``, ``rosen_der``, ``rosen_hess``; chord retraction, identity metric."""
+
+    def __init__(self, fun, jac, hess, force_scale: float = 1.0, energy_scale: float = 1.0):  # type: ignore[no-untyped-def]
+        self.fun, self.jac, self.hess = fun, jac, hess
+        self.force_scale = force_scale
+        self.energy_scale = energy_scale
+        self._n: int | None = None
+
+    def evaluate(self, x, need_grad, need_hess):  # type: ignore[no-untyped-def]
+        self._n = len(x)
+        return (
+            float(self.fun(x)),
+            np.asarray(self.jac(x), dtype=float) if need_grad else None,
+            np.asarray(self.hess(x), dtype=float) if need_hess else None,
+        )
+
+    def metric(self) -> FloatArray:
+        return np.ones(self._n or 0)
+
+    def weights(self) -> FloatArray:
+        return np.ones(self._n or 0)
+
+    def retract(self, x: FloatArray, d: FloatArray, alpha: float) -> FloatArray:
+        return x + alpha * d
+
+    def accept(self, x: FloatArray) -> None:
+        return None

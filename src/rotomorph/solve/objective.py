@@ -1,0 +1,326 @@
+"""The rod network as a Newton objective: energy, gradient and Hessian of free DOFs.
+
+Each evaluation is relative to a *base* configuration (the last accepted iterate): reference
+frames are transported in time from the base, reference twists unwrapped from the base's.
+Positions and twist angles of fixed DOFs keep their base values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.errors import InvalidParameterError
+from rotomorph.rod.assembly import (
+    evaluate_network,
+    reference_twist,
+    scatter_banded,
+    scatter_sparse,
+    transport_frames,
+)
+from rotomorph.rod.model import Model
+from rotomorph.rod.state import State
+from rotomorph.solve.linalg import BandedMatrix
+from rotomorph.solve.loads import Loads, Supports
+from rotomorph.solve.retraction import EdgeRotationRetraction
+
+BANDED_LIMIT = 64  # half-bandwidth above which the sparse path is used
+
+
+class RodObjective:
+    """Static equilibrium of a :class:`~rotomorph.rod.model.Model` as an objective."""
+
+    def __init__(self, model: Model, state: State, supports: Supports, loads: Loads) -> None:
+        self.model = model
+        net, st, lay = model.network, model.stencils, model.layout
+        self._edges = np.ascontiguousarray(net.edges)
+        n, ne = net.n_nodes, net.n_edges
+        fixed = np.zeros(lay.count, dtype=bool)
+        for j in supports.clamped_edges:
+            j = _check_index("Supports.clamped_edges", j, ne)
+            for node in net.edges[j]:
+                fixed[lay.pos[node] + np.arange(3)] = True
+            fixed[lay.theta[j]] = True
+        for node in supports.pinned_nodes:
+            node = _check_index("Supports.pinned_nodes", node, n)
+            fixed[lay.pos[node] + np.arange(3)] = True
+        for j in supports.fixed_twist_edges:
+            fixed[lay.theta[_check_index("Supports.fixed_twist_edges", j, ne)]] = True
+        self.free: IntArray = np.flatnonzero(~fixed)
+        fixed_nodes = np.flatnonzero(fixed[lay.pos[:, None] + np.arange(3)].all(axis=1))
+        self._retraction = EdgeRotationRetraction(self._edges, n, fixed_nodes)
+        reduced = -np.ones(lay.count, dtype=np.int64)
+        reduced[self.free] = np.arange(len(self.free))
+        self._reduced = reduced
+        self._pos_index = (lay.pos[:, None] + np.arange(3)).ravel()
+        self._theta_index = lay.theta
+        self._st_dofs = lay.stencil_dofs(st)
+        self._ed_dofs = lay.edge_dofs(net.edges)
+        b1, b2, c = model.stencil_stiffness
+        self._stiff = (np.ascontiguousarray(b1), np.ascontiguousarray(b2), np.ascontiguousarray(c))
+        k1, k2, tw = model.integrated_natural()
+        self._natural = (np.ascontiguousarray(k1), np.ascontiguousarray(k2),
+                         np.ascontiguousarray(tw))
+        self._vor = np.ascontiguousarray(model.voronoi_length)
+        self._st_edges = np.ascontiguousarray(np.stack([st.edge_e, st.edge_f], axis=1))
+        self._st_signs = np.ascontiguousarray(np.stack([st.sign_e, st.sign_f], axis=1))
+        self._st_params = np.ascontiguousarray(np.stack([b1, b2, c, self._vor, k1, k2, tw], 1))
+        self._ed_params = np.ascontiguousarray(
+            np.stack([model.axial_stiffness, model.rest_length], axis=1))
+        self._external = self._external_forces(loads)
+        self._has_forces = bool(np.any(self._external))
+        self._st_nodes = np.ascontiguousarray(st.nodes)
+        self._moment_edges, self._moments = self._edge_moments(loads)
+        if supports.is_free and np.linalg.norm(self._external[self._pos_index].reshape(-1, 3).sum(0)) > 0:
+            raise InvalidParameterError(
+                "Supports", "a free body under a net external force has no equilibrium; "
+                "pin or clamp at least one node",
+            )
+        # work buffers
+        self._grad = np.zeros(lay.count)
+        self._st_hess = np.zeros((st.count, 11, 11))
+        self._ed_hess = np.zeros((ne, 6, 6))
+        self._t = np.empty((ne, 3))
+        self._d1 = np.empty((ne, 3))
+        self._m1 = np.empty((ne, 3))
+        self._m2 = np.empty((ne, 3))
+        self._mref = np.empty(st.count)
+        self._setup_matrix()
+        self.set_base(state)
+        self._setup_scales(loads)
+
+    # ------------------------------------------------------------------ set-up
+    def _external_forces(self, loads: Loads) -> FloatArray:
+        net, lay = self.model.network, self.model.layout
+        f = np.zeros(lay.count)
+        for node, force in loads.forces:
+            node = _check_index("Loads.forces", node, net.n_nodes)
+            vec = _vector("Loads.forces", force)
+            f[lay.pos[node] + np.arange(3)] += vec
+        if loads.gravity is not None:
+            w = loads.gravity.line_weight(net.n_edges) * self.model.rest_length
+            d = np.asarray(loads.gravity.direction, float)
+            d = d / np.linalg.norm(d)
+            for end in (0, 1):
+                for k in range(3):
+                    np.add.at(f, lay.pos[net.edges[:, end]] + k, 0.5 * w * d[k])
+        return f
+
+    def _edge_moments(self, loads: Loads) -> tuple[IntArray, FloatArray]:
+        net = self.model.network
+        edges, vecs = [], []
+        for node, moment in loads.moments:
+            node = _check_index("Loads.moments", node, net.n_nodes)
+            starts = np.flatnonzero(net.edges[:, 0] == node)
+            ends = np.flatnonzero(net.edges[:, 1] == node)
+            cand = starts if len(starts) else ends
+            if not len(cand):
+                raise InvalidParameterError("Loads.moments", f"node {node} has no edge")
+            edges.append(int(cand[0]))
+            vecs.append(_vector("Loads.moments", moment))
+        return np.array(edges, dtype=np.int64), np.array(vecs, dtype=float).reshape(-1, 3)
+
+    def _setup_matrix(self) -> None:
+        red = self._reduced
+        rs, re_ = red[self._st_dofs], red[self._ed_dofs]
+        spans = [np.max(np.abs(r[:, :, None] - r[:, None, :]) * ((r[:, :, None] >= 0)
+                 & (r[:, None, :] >= 0))) for r in (rs, re_) if r.size]
+        self.bandwidth = int(max(spans)) if spans else 0
+        nfree = len(self.free)
+        self.banded = self.bandwidth <= BANDED_LIMIT
+        if self.banded:
+            self._ab = np.zeros((self.bandwidth + 1, nfree), order="F")
+            return
+        rows = np.concatenate([np.repeat(rs, 11, axis=1).ravel(),
+                               np.repeat(re_, 6, axis=1).ravel()])
+        cols = np.concatenate([np.tile(rs, (1, 11)).ravel(), np.tile(re_, (1, 6)).ravel()])
+        ok = (rows >= 0) & (cols >= 0)
+        keys = np.where(ok, cols * nfree + rows, -1)
+        uniq, inv = np.unique(keys[ok], return_inverse=True)
+        slots = -np.ones(len(keys), dtype=np.int64)
+        slots[ok] = inv
+        ns = len(self._st_dofs) * 121
+        self._st_slot = slots[:ns].reshape(-1, 11, 11)
+        self._ed_slot = slots[ns:].reshape(-1, 6, 6)
+        indices = (uniq % nfree).astype(np.int32)
+        counts = np.bincount(uniq // nfree, minlength=nfree)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        self._csc_pattern = (indices, indptr)
+        self._data = np.zeros(len(uniq))
+
+    def _setup_scales(self, loads: Loads) -> None:
+        net = self.model.network
+        ext = np.ptp(net.nodes, axis=0).max() or float(self.model.rest_length.sum())
+        self.length_scale = float(max(ext, self.model.rest_length.max()))
+        lmean = float(self.model.rest_length.mean())
+        b1, b2, c = self._stiff
+        stiff = np.maximum(np.maximum(b1, b2), c)
+        k1, k2, tw = self._natural
+        kint = np.sqrt(k1**2 + k2**2 + tw**2) + self._vor / self.length_scale
+        self.force_scale = float(
+            np.sqrt(np.sum((stiff / self._vor * kint / lmean) ** 2))
+            + np.abs(self._external).sum()
+            + (np.linalg.norm(self._moments, axis=1).sum() / lmean if len(self._moments) else 0)
+        )
+        self.energy_scale = float(
+            np.sum(0.5 * stiff / self._vor * kint**2)
+            + np.abs(self._external).sum() * self.length_scale
+            + (np.linalg.norm(self._moments, axis=1).sum() if len(self._moments) else 0.0)
+        )
+        lay = self.model.layout
+        m = np.zeros(lay.count)
+        half = 0.5 * self.model.rest_length
+        for end in (0, 1):
+            for k in range(3):
+                np.add.at(m, lay.pos[net.edges[:, end]] + k, half)
+        m[lay.theta] = self.model.rest_length * (self.model.twist_stiffness
+                                                 / self.model.axial_stiffness)
+        self._metric = m[self.free]
+        wt = np.ones(lay.count)
+        wt[lay.theta] = 1.0 / lmean
+        self._weights = wt[self.free]
+
+    # ------------------------------------------------------------------ state handling
+    def set_base(self, state: State) -> None:
+        """Make ``state`` the base of later evaluations."""
+        self.base = state
+        u = np.empty(self.model.layout.count)
+        u[self._pos_index] = state.positions.ravel()
+        u[self._theta_index] = state.theta
+        self._u_base = u
+
+    def vector(self, state: State | None = None) -> FloatArray:
+        """Free-DOF vector of ``state`` (default: the base)."""
+        if state is None:
+            return self._u_base[self.free].copy()
+        u = self._u_base.copy()
+        u[self._pos_index] = state.positions.ravel()
+        u[self._theta_index] = state.theta
+        return u[self.free]
+
+    def _unpack(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        u = self._u_base.copy()
+        u[self.free] = q
+        return u[self._pos_index].reshape(-1, 3), u[self._theta_index]
+
+    def state(self, q: FloatArray) -> State:
+        """The configuration of free-DOF vector ``q`` (frames transported from the base)."""
+        pos, theta = self._unpack(q)
+        t, d1 = np.empty_like(self._t), np.empty_like(self._d1)
+        transport_frames(pos, self._edges, self.base.tangents, self.base.directors, t, d1)
+        st = self.model.stencils
+        mref = np.empty(st.count)
+        reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1,
+                        self.base.reference_twist, mref)
+        return State(positions=pos, theta=theta, tangents=t, directors=d1, reference_twist=mref)
+
+    def accept(self, q: FloatArray) -> None:
+        """Re-base at ``q`` (time-parallel transport of the frames)."""
+        self.set_base(self.state(q))
+
+    # ------------------------------------------------------------------ objective
+    def evaluate(self, q: FloatArray, need_grad: bool, need_hess: bool):  # type: ignore[no-untyped-def]
+        """Total potential energy (N mm), gradient and Hessian of the free DOFs."""
+        u = self._u_base.copy()
+        u[self.free] = q
+        pos = u[self._pos_index].reshape(-1, 3)
+        theta = u[self._theta_index]
+        base = self.base
+        lay = self.model.layout
+        energy = evaluate_network(
+            pos, theta, base.tangents, base.directors, base.reference_twist,
+            self._t, self._d1, self._m1, self._m2, self._mref,
+            self._edges, self._st_nodes, self._st_edges, self._st_signs, self._st_params,
+            self._ed_params, lay.pos, lay.theta, lay.count,
+            need_grad, need_hess, self._grad, self._st_hess, self._ed_hess,
+        )
+        grad = self._grad
+        if self._has_forces:
+            energy -= float(self._external @ u)
+            if need_grad:
+                grad = grad - self._external
+        if not need_grad:
+            grad = None
+        if len(self._moments):
+            energy += self._moment_terms(pos, theta, grad, need_hess)
+        if grad is not None:
+            grad = grad[self.free]
+            if grad is self._grad:  # pragma: no cover - fancy indexing always copies
+                grad = grad.copy()
+        hess = self._hessian() if need_hess else None
+        return float(energy), grad, hess
+
+    def _moment_terms(self, pos, theta, grad, need_hess):  # type: ignore[no-untyped-def]
+        """Dead moments: potential -M.(t_base x t) - (M.t_base)(theta - theta_base).
+
+        Exact to second order in the rotation from the base, so the equilibrium and the Newton
+        Hessian at the base are exact.
+        """
+        lay, edges = self.model.layout, self._edges
+        energy = 0.0
+        for j, M in zip(self._moment_edges, self._moments, strict=True):
+            a, b = edges[j]
+            e = pos[b] - pos[a]
+            ln = np.linalg.norm(e)
+            t = e / ln
+            tb = self.base.tangents[j]
+            cvec = np.cross(M, tb)
+            mt = float(M @ tb)
+            energy += -float(cvec @ t) - mt * (theta[j] - self.base.theta[j])
+            P = np.eye(3) - np.outer(t, t)
+            if grad is not None:
+                ge = -(P @ cvec) / ln
+                grad[lay.pos[a] + np.arange(3)] -= ge
+                grad[lay.pos[b] + np.arange(3)] += ge
+                grad[lay.theta[j]] -= mt
+            if need_hess:
+                h = (np.outer(t, P @ cvec) + np.outer(P @ cvec, t) + (cvec @ t) * P) / ln**2
+                blk = np.block([[h, -h], [-h, h]])
+                self._ed_hess[j] += blk
+        return energy
+
+    def _hessian(self):  # type: ignore[no-untyped-def]
+        if self.banded:
+            scatter_banded(self._st_hess, self._st_dofs, self._ed_hess, self._ed_dofs,
+                           self._reduced, self.bandwidth, self._ab)
+            return BandedMatrix(self._ab.copy(order="F"), self.bandwidth)
+        scatter_sparse(self._st_hess, self._st_slot, self._ed_hess, self._ed_slot, self._data)
+        n = len(self.free)
+        indices, indptr = self._csc_pattern
+        return sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
+
+    def metric(self) -> FloatArray:
+        """Lumped metric: Voronoi length per position DOF, length x C/EA per twist angle."""
+        return self._metric
+
+    def weights(self) -> FloatArray:
+        """1 for forces (N); 1/(mean edge length) for moments (N mm)."""
+        return self._weights
+
+    def retract(self, q: FloatArray, d: FloatArray, alpha: float) -> FloatArray:
+        """Step along ``d``: edges rotated (see :mod:`~rotomorph.solve.retraction`), twist
+        angles moved linearly; fixed DOFs keep their values."""
+        u = self._u_base.copy()
+        u[self.free] = q
+        du = np.zeros_like(u)
+        du[self.free] = d
+        pos = u[self._pos_index].reshape(-1, 3)
+        dpos = du[self._pos_index].reshape(-1, 3)
+        u[self._pos_index] = self._retraction(pos, dpos, alpha).ravel()
+        u[self._theta_index] += alpha * du[self._theta_index]
+        return u[self.free]
+
+
+def _check_index(field: str, value: object, n: int) -> int:
+    i = int(value)  # type: ignore[call-overload]
+    if not 0 <= i < n:
+        raise InvalidParameterError(field, f"index {i} is out of range [0, {n - 1}]")
+    return i
+
+
+def _vector(field: str, value: object) -> FloatArray:
+    v = np.asarray(value, dtype=float)
+    if v.shape != (3,) or not np.isfinite(v).all():
+        raise InvalidParameterError(field, f"needs finite 3-vectors; got {value!r}")
+    return v

@@ -1,0 +1,58 @@
+"""Result records of the solvers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+
+
+class Status(Enum):
+    """How a solve ended. Only ``CONVERGED`` is success; an iteration limit is never success."""
+
+    CONVERGED = "converged"
+    MAX_ITERATIONS = "max_iterations"
+    LINE_SEARCH_FAILED = "line_search_failed"
+    NOT_FINITE = "not_finite"
+
+
+@dataclass(frozen=True, eq=False)
+class NewtonResult:
+    """Outcome of :func:`rotomorph.solve.newton.minimize`.
+
+    Attributes
+    ----------
+    x
+        Final iterate.
+    status
+        How the iteration ended.
+    iterations
+        Newton iterations taken (Hessian evaluations).
+    factorizations
+        Linear factorizations (including rejected shifted attempts).
+    energy
+        Objective value at ``x``.
+    residual
+        Weighted gradient norm at ``x`` divided by the force scale (dimensionless).
+    decrement
+        Last Newton decrement ``-g.d`` divided by the energy scale (dimensionless).
+    history
+        Per-iteration ``(energy, residual, step length, shift)`` rows.
+    """
+
+    x: FloatArray
+    status: Status
+    iterations: int
+    factorizations: int
+    energy: float
+    residual: float
+    decrement: float
+    history: FloatArray = field(default_factory=lambda: np.zeros((0, 4)))
+
+    @property
+    def converged(self) -> bool:
+        """True when the status is ``CONVERGED``."""
+        return self.status is Status.CONVERGED

@@ -1,0 +1,146 @@
+"""Moving a rod network along a Newton step by rotating its edges (a retraction).
+
+A chord step ``x + alpha dx`` stretches every edge it turns (a rotation by angle ``phi`` of an
+edge of length ``l`` lengthens it by ``l phi^2 / 2``), which the stiff stretching energy punishes
+and the line search answers with short steps. Instead, each edge is rotated by the rotation the
+step implies (axis and angle from the perpendicular part of ``de``) and stretched by its axial
+part; the nodes are then recomposed from the edges: exactly, by accumulation from a root, when
+the network is a tree with at most one supported node (a single filament), else by least
+squares on the graph with supported nodes held fixed (or the first node moved linearly for a
+free body). To first order in ``alpha`` this is the chord step, so the Newton direction and the
+Armijo test are unchanged (a retraction in the sense of Absil, Mahony & Sepulchre,
+*Optimization Algorithms on Matrix Manifolds*, 2008, § 4.1).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numba import njit
+
+from rotomorph._typing import FloatArray, IntArray
+
+
+@njit(cache=True)
+def _edge_targets(x, dx, alpha, edges, out):
+    """Rotated and stretched edge vectors ``(E, 3)`` for step ``alpha dx``."""
+    for j in range(edges.shape[0]):
+        a = edges[j, 0]
+        b = edges[j, 1]
+        e0 = x[b, 0] - x[a, 0]
+        e1 = x[b, 1] - x[a, 1]
+        e2 = x[b, 2] - x[a, 2]
+        d0 = dx[b, 0] - dx[a, 0]
+        d1 = dx[b, 1] - dx[a, 1]
+        d2 = dx[b, 2] - dx[a, 2]
+        ln = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        t0, t1, t2 = e0 / ln, e1 / ln, e2 / ln
+        axial = (t0 * d0 + t1 * d1 + t2 * d2) / ln
+        # rotation vector w = alpha * t x de / |e|
+        w0 = alpha * (t1 * d2 - t2 * d1) / ln
+        w1 = alpha * (t2 * d0 - t0 * d2) / ln
+        w2 = alpha * (t0 * d1 - t1 * d0) / ln
+        ang = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        scale = ln * (1.0 + alpha * axial)
+        if ang > 0.0:
+            k0, k1, k2 = w0 / ang, w1 / ang, w2 / ang
+            c = np.cos(ang)
+            s = np.sin(ang)
+            # Rodrigues for k perpendicular to t: t c + (k x t) s
+            out[j, 0] = scale * (c * t0 + s * (k1 * t2 - k2 * t1))
+            out[j, 1] = scale * (c * t1 + s * (k2 * t0 - k0 * t2))
+            out[j, 2] = scale * (c * t2 + s * (k0 * t1 - k1 * t0))
+        else:
+            out[j, 0] = scale * t0
+            out[j, 1] = scale * t1
+            out[j, 2] = scale * t2
+
+
+@njit(cache=True)
+def _accumulate_tree(x, dx, alpha, root, move_root, order, parent, parent_edge, sign, target, out):
+    for k in range(3):
+        out[root, k] = x[root, k] + (alpha * dx[root, k] if move_root else 0.0)
+    for i in range(order.shape[0]):
+        n = order[i]
+        p = parent[n]
+        j = parent_edge[n]
+        for k in range(3):
+            out[n, k] = out[p, k] + sign[n] * target[j, k]
+
+
+class EdgeRotationRetraction:
+    """Retraction for node positions of a network with ``edges`` and fixed nodes ``fixed``."""
+
+    def __init__(self, edges: IntArray, n_nodes: int, fixed_nodes: IntArray) -> None:
+        self.edges = np.ascontiguousarray(edges, dtype=np.int64)
+        self._target = np.empty((len(edges), 3))
+        fixed = np.zeros(n_nodes, dtype=bool)
+        fixed[fixed_nodes] = True
+        self.anchor_first = not fixed.any()
+        is_tree = len(edges) == n_nodes - 1 and fixed.sum() <= 1
+        if is_tree:
+            root = int(np.flatnonzero(fixed)[0]) if fixed.any() else 0
+            tree = _bfs_tree(self.edges, n_nodes, root)
+            if tree is not None:
+                self._tree = (root, *tree)
+                return
+        self._tree = None
+        if self.anchor_first:
+            fixed[0] = True
+        self.fixed = np.flatnonzero(fixed)
+        self.free = np.flatnonzero(~fixed)
+        e = len(edges)
+        B = sp.csr_matrix(
+            (np.r_[-np.ones(e), np.ones(e)], (np.r_[np.arange(e), np.arange(e)],
+                                              np.r_[edges[:, 0], edges[:, 1]])),
+            shape=(e, n_nodes),
+        )
+        self._Bd = B[:, self.fixed].tocsc()
+        Bf = B[:, self.free].tocsc()
+        self._BfT = Bf.T.tocsr()
+        self._lu = spla.splu((self._BfT @ Bf).tocsc()) if len(self.free) else None
+
+    def __call__(self, x: FloatArray, dx: FloatArray, alpha: float) -> FloatArray:
+        """Node positions ``(N, 3)`` reached from ``x`` along ``alpha dx`` (both ``(N, 3)``)."""
+        _edge_targets(x, dx, alpha, self.edges, self._target)
+        out = np.empty_like(x)
+        if self._tree is not None:
+            root, order, parent, parent_edge, sign = self._tree
+            _accumulate_tree(x, dx, alpha, root, self.anchor_first, order, parent, parent_edge,
+                             sign, self._target, out)
+            return out
+        xd = x[self.fixed] + (alpha * dx[self.fixed] if self.anchor_first else 0.0)
+        out[self.fixed] = xd
+        if self._lu is not None:
+            rhs = self._BfT @ (self._target - self._Bd @ xd)
+            out[self.free] = self._lu.solve(np.ascontiguousarray(rhs))
+        return out
+
+
+def _bfs_tree(edges: IntArray, n: int, root: int):  # type: ignore[no-untyped-def]
+    """Breadth-first order, parents, parent edges and signs; None if not connected."""
+    adj: list[list[tuple[int, int, float]]] = [[] for _ in range(n)]
+    for j, (a, b) in enumerate(edges):
+        adj[a].append((b, j, 1.0))
+        adj[b].append((a, j, -1.0))
+    parent = -np.ones(n, dtype=np.int64)
+    parent_edge = -np.ones(n, dtype=np.int64)
+    sign = np.zeros(n)
+    seen = np.zeros(n, dtype=bool)
+    seen[root] = True
+    order: list[int] = []
+    queue = deque([root])
+    while queue:
+        p = queue.popleft()
+        for c, j, s in adj[p]:
+            if not seen[c]:
+                seen[c] = True
+                parent[c], parent_edge[c], sign[c] = p, j, s
+                order.append(c)
+                queue.append(c)
+    if not seen.all():
+        return None
+    return np.array(order, dtype=np.int64), parent, parent_edge, sign
