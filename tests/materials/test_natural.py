@@ -39,7 +39,8 @@ def straight(
     pts = np.column_stack([s, np.zeros(n), np.zeros(n)])
     rot = omega_star * speed / R
     mid = 0.5 * (s[:-1] + s[1:])
-    return Program(pts, np.full(n, speed), np.full(n, rot), (rot / speed) * mid)
+    # design-layer convention (notes 1.1): alpha = psi - alpha_n, so d(alpha)/ds = -omega/v
+    return Program(pts, np.full(n, speed), np.full(n, rot), -(rot / speed) * mid)
 
 
 def test_straight_janus_without_rotation() -> None:
@@ -68,9 +69,10 @@ def test_rotated_filament_matches_closed_form_helix() -> None:
     nf = natural_field(prog, temperature=175.0, model=MODEL)
     section = MODEL.section(*_inks(), R, 0.5)
     e_par, e_perp, eps_p = MODEL.strains(3.0, _inks()[1])
-    _, kappa, dtau = section.natural_strains(0.25, e_par, e_perp, eps_p)
+    _, kappa, dtau = section.natural_strains(-0.25, e_par, e_perp, eps_p)
     x = nf.actuation
-    np.testing.assert_allclose(nf.twist, 0.25 / R + x * dtau[0], rtol=1e-6)
+    assert dtau[0] > 0  # untwists the printed (negative) interface twist
+    np.testing.assert_allclose(nf.twist, -0.25 / R + x * dtau[0], rtol=1e-6)
     np.testing.assert_allclose(nf.curvature1, x * kappa[0, 0], rtol=1e-6)
     # directors rotate with the interface angle about the tangent: n = cos a z + sin a (t x z)
     a = prog.interface_angle
@@ -80,6 +82,16 @@ def test_rotated_filament_matches_closed_form_helix() -> None:
     ref = filament_shapes(MODEL, [0.25], 0.5)[0]
     assert shape.end_to_end_ratio == pytest.approx(ref.end_to_end_ratio, rel=1e-3)
     assert shape.label == ref.label
+
+
+def test_opposite_rotation_convention_is_reported(caplog: pytest.LogCaptureFixture) -> None:
+    prog = straight(omega_star=0.25)
+    flipped = replace(prog, interface_angle=-prog.interface_angle)
+    with caplog.at_level("WARNING", logger="rotomorph.materials.natural"):
+        natural_field(prog, model=MODEL)
+        assert not caplog.records
+        natural_field(flipped, model=MODEL)
+    assert "sign convention" in caplog.text
 
 
 def test_cold_filament_keeps_printed_curvature_and_sign_of_actuation() -> None:

@@ -174,3 +174,22 @@ def test_bad_inputs() -> None:
         axial_section(disk_mesh(R, 0.5, 32), phase_constant(1.0, -1.0))
     with pytest.raises(InvalidParameterError, match="e_active"):
         filament_section(R, 0.0, 1.0)
+
+
+def test_pure_sections_are_special_cases() -> None:
+    e = 2.0
+    lce = filament_section(R, e, 1.0, active_fraction=1.0, resolution=128)
+    for b in (lce.bending_stiffness1, lce.bending_stiffness2):
+        assert b == pytest.approx(e * math.pi * R**4 / 4, rel=QUAD_RTOL)
+    assert lce.twist_stiffness == pytest.approx(e / 3 * math.pi * R**4 / 2, rel=QUAD_RTOL)
+    assert lce.axial_stiffness == pytest.approx(e * math.pi * R**2, rel=QUAD_RTOL)
+    # pure passive = homogeneous disk with an isotropic eigenstrain: pure stretch, nothing else
+    eps_c, kappa, tau = lce.natural_strains(0.7, 0.03, 0.03, 0.0)
+    assert eps_c[0] == pytest.approx(0.03, rel=1e-12)
+    np.testing.assert_allclose(kappa, 0.0, atol=1e-12)
+    np.testing.assert_allclose(tau, 0.0, atol=1e-12)
+    # Janus section with equal strains in both phases: same result
+    jan = filament_section(R, 3.0, 1.0, resolution=64)
+    eps_c, kappa, tau = jan.natural_strains(0.0, 0.03, 0.03, 0.03)
+    assert eps_c[0] == pytest.approx(0.03, rel=1e-12)
+    np.testing.assert_allclose(kappa, 0.0, atol=1e-12)

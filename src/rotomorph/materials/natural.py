@@ -15,6 +15,14 @@ fraction x(T),
 with K_J, Δτ, ε_c from the section of each edge (print speed and rotation averaged over the two
 end vertices) and averaged over the two edges of each interior vertex.
 
+Handedness: the LCE director, the material lines and the interface form helices of the same
+sense (notes 1.1), so the director helix in the filament frame turns with the part of dα/ds that
+the nozzle rotation causes. With the design layer's convention α = ψ − α_n (notes 1.1, planar
+paths: dα/ds = κ_p − ω/v) that rate is −ω/v, i.e. the signed rotation rate of the director
+field is ω*_dir = :data:`DIRECTOR_HELIX_SENSE` · Rω/v with sense −1. On straight stretches the
+printed twist dα/ds then has the sign of ω*_dir and the eigen-twist Δτ the opposite sign
+(untwisting); a warning is logged when a program contradicts this.
+
 Moduli at the actuation temperature are not measured (notes 1.2, Q9). The passive modulus is
 taken at its 25 °C value and the active one as ``FilamentModel.modulus_ratio`` × E_p: the
 room-temperature ratio 52 under-predicts the Janus curvature 2-4× (notes 1.7), so the ratio is
@@ -23,6 +31,7 @@ calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for un
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -41,6 +50,12 @@ from rotomorph.materials.process import (
     actuation_fraction,
     dimensionless_rotation,
 )
+
+logger = logging.getLogger(__name__)
+
+#: Sign relating the nozzle rotation ω to the director-helix rate in the filament frame
+#: (α = ψ − α_n, notes 1.1; rotomorph.design.program).
+DIRECTOR_HELIX_SENSE = -1.0
 
 #: Effective E_a/E_p at actuation (Hencky WT strains, Q = S), calibrated on K_J(v = 3 mm/s) =
 #: 0.59 ± 0.04 mm⁻¹ with ``calibrate(load_table("janus_curvature"), ["modulus_ratio"], use=[3])``:
@@ -238,6 +253,22 @@ def _material(name: str, materials: Mapping[str, Material] | None, kind: str) ->
     return mat
 
 
+def _check_handedness(k1: FloatArray, k2: FloatArray, tw: FloatArray, w: FloatArray) -> None:
+    """Warn when, on straight stretches, the printed twist opposes the director helix."""
+    w_vertex = 0.5 * (w[:-1] + w[1:])
+    straight = (np.hypot(k1, k2) < 1e-9) & (np.abs(w_vertex) > 1e-9)
+    if np.any(straight):
+        agree = np.sign(tw[straight]) == np.sign(w_vertex[straight])
+        if np.mean(agree) < 0.5:
+            logger.warning(
+                "printed interface twist opposes the director helix on %d straight vertices; "
+                "check the sign convention of PrintProgram.rotation vs interface_angle "
+                "(expected dα/ds = %+g·ω/v)",
+                int(np.sum(~agree)),
+                DIRECTOR_HELIX_SENSE,
+            )
+
+
 def natural_field(
     program: Any,
     materials: Mapping[str, Material] | None = None,
@@ -286,7 +317,7 @@ def natural_field(
     )
     edge_speed = 0.5 * (speed[:-1] + speed[1:])
     edge_rot = 0.5 * (rot[:-1] + rot[1:])
-    omega_star = dimensionless_rotation(edge_rot, edge_speed, radius)
+    omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
     section = model.section(active, passive, radius, frac)
     e_par, e_perp, eps_p = model.strains(edge_speed, passive)
     eps_c, kappa, dtau = section.natural_strains(omega_star, e_par, e_perp, eps_p)
@@ -295,6 +326,7 @@ def natural_field(
     t = geometry.unit(np.diff(pts, axis=0))
     directors = geometry.rotate_about_tangent(d1, t, alpha)
     k1, k2, tw, vor = geometry.polyline_strains(pts, directors)
+    _check_handedness(k1, k2, tw, omega_star)
 
     def at_vertices(a: FloatArray) -> FloatArray:
         return 0.5 * (a[:-1] + a[1:])

@@ -26,6 +26,7 @@ dimensionless rotation rate ω* = Rω/v, surface helix angle φ = atan ω*, nema
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from typing import Literal, Protocol, runtime_checkable
 
@@ -33,6 +34,8 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
+
+logger = logging.getLogger(__name__)
 
 Measure = Literal["hencky", "engineering"]
 ABSOLUTE_ZERO = -273.15  # °C
@@ -139,6 +142,10 @@ def order_parameter(
     lv = np.log([p[0] for p in pts])
     s = np.array([p[1] for p in pts])
     x = np.log(v)
+    if np.any((x < lv[0]) | (x > lv[-1])):
+        logger.debug(
+            "order_parameter: extrapolating S(v) outside %g..%g mm/s", pts[0][0], pts[-1][0]
+        )
     seg = np.clip(np.searchsorted(lv, x) - 1, 0, len(lv) - 2)
     slope = (s[seg + 1] - s[seg]) / (lv[seg + 1] - lv[seg])
     return np.clip(s[seg] + slope * (x - lv[seg]), 0.0, 0.99)
