@@ -95,3 +95,16 @@ def test_program_is_frozen_and_read_only():
         prog.speed[0] = 2.0
     assert prog.duration == pytest.approx(1.0)
     assert prog.with_layer(2, 1.2).points[:, 2].tolist() == [1.2] * 3
+
+
+def test_flip_length_limits_the_rotation_rate():
+    path = Path.from_segments([Sinusoid(1.0, 5.0, 2)], spacing=0.05)
+    step = PrintProgram.sinusoid_with_active_side(path, 3.0, "outer")
+    smooth = PrintProgram.sinusoid_with_active_side(path, 3.0, "outer", flip_length=0.5)
+    assert np.abs(step.rotation).max() > 60.0
+    assert np.abs(smooth.rotation).max() < 3.0 * np.pi / 0.5 * 1.2
+    # away from the inflections the active side is unchanged
+    far = np.abs(path.curvature) > 0.5 * np.abs(path.curvature).max()
+    np.testing.assert_allclose(smooth.nozzle_angle[far], step.nozzle_angle[far], atol=1e-9)
+    with pytest.raises(InvalidDesignError, match="flip_length"):
+        PrintProgram.sinusoid_with_active_side(path, 3.0, flip_length=-1.0)

@@ -138,3 +138,21 @@ def test_schema_export():
     assert schema["properties"]["schema_version"]["const"] == 1
     assert {"filaments", "lattice", "nozzle"} <= set(schema["properties"])
     assert "Filament" in schema["$defs"] and "LatticeModel" in schema["$defs"]
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_example_prints_on_a_default_machine(path):
+    from rotomorph.io.gcode import gcode_text
+    from rotomorph.io.gcode_read import parse_gcode
+    from rotomorph.io.machine import MachineProfile
+
+    design = load_design(path)
+    machine = MachineProfile()
+    progs = design.to_programs()
+    read = parse_gcode(
+        gcode_text(progs, machine, layer_cure_s=600, **design.gcode_options()), machine
+    )
+    assert len(read) == len(progs)
+    assert all(
+        np.allclose(r.program.points, p.points, atol=1e-4) for r, p in zip(read, progs, strict=True)
+    )

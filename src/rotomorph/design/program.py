@@ -313,6 +313,8 @@ class PrintProgram:
         path: Path | FloatArray,
         speed: Profile,
         side: Literal["outer", "inner"] = "outer",
+        *,
+        flip_length: float = 0.0,
         **kwargs: object,
     ) -> PrintProgram:
         """Keep the active half on the in-plane outer (or inner) side of the path's curvature.
@@ -331,8 +333,12 @@ class PrintProgram:
         side
             ``"outer"`` (active on the convex side: straightening/expanding) or ``"inner"``
             (curling/contracting) [PAPER].
+        flip_length
+            Arc length (mm) over which each π flip is spread (0: a step at the inflection);
+            choose about ``π v / max_rotation`` to respect the machine's rotation limit.
         """
-        return cls.from_interface_angle(path, speed, active_side_angle(path, side), **kwargs)
+        alpha = active_side_angle(path, side, flip_length)
+        return cls.from_interface_angle(path, speed, alpha, **kwargs)
 
 
 def _vertex_heading(path: Path) -> FloatArray:
@@ -341,10 +347,14 @@ def _vertex_heading(path: Path) -> FloatArray:
     return np.concatenate([[h[0]], inner, [h[-1]]])
 
 
-def active_side_angle(path: Path | FloatArray, side: str | FloatArray = "outer") -> FloatArray:
+def active_side_angle(
+    path: Path | FloatArray, side: str | FloatArray = "outer", flip_length: float = 0.0
+) -> FloatArray:
     """Per-vertex interface angle (rad) putting the active half outer/inner (see above).
 
     ``side`` may also be an ``(N,)`` array of +1 (outer) / -1 (inner) per vertex.
+    ``flip_length`` (mm, >= 0) spreads each π flip over that arc length (a moving average of
+    the step), so the nozzle turns at about ``π v / flip_length`` rad/s (notes Q6).
     """
     p = path if isinstance(path, Path) else Path(path)
     if isinstance(side, str):
@@ -357,4 +367,13 @@ def active_side_angle(path: Path | FloatArray, side: str | FloatArray = "outer")
     sign = np.where(np.abs(kappa) < _ZERO_CURVATURE, 0.0, np.sign(kappa))
     if len(sign) > 2:  # the end vertices have no turning angle: continue the neighbour's side
         sign[0], sign[-1] = sign[1], sign[-2]
-    return sgn * sign * (np.pi / 2)
+    alpha = sgn * sign * (np.pi / 2)
+    if not (np.isfinite(flip_length) and flip_length >= 0):
+        raise InvalidDesignError("flip_length", f"must be >= 0 mm; got {flip_length}")
+    if flip_length > 0:
+        s = p.arc_length
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (alpha[1:] + alpha[:-1]) * np.diff(s))])
+        lo = np.clip(s - flip_length / 2, 0.0, s[-1])
+        hi = np.clip(s + flip_length / 2, 0.0, s[-1])
+        alpha = (np.interp(hi, s, cum) - np.interp(lo, s, cum)) / (hi - lo)
+    return alpha

@@ -25,7 +25,8 @@ Per segment, ``speed`` (mm/s) overrides the filament's (piecewise-constant v(s))
 driven by at most one of ``rotation`` (ω, rad/s), ``rotation_number`` (ω*) or
 ``interface_angle_deg`` (α held constant, nozzle tracks the heading); a filament-level
 ``active_side = "outer" | "inner"`` keeps the active half on one side of the curvature
-(notes Q6). Angles in files are in degrees (``*_deg``), everything else in mm, s, rad/s, psi.
+(notes Q6), with ``flip_length`` (mm) spreading each π flip. Angles in files are in degrees
+(``*_deg``), everything else in mm, s, rad/s, psi.
 
 Errors name the field path and the fix, e.g.
 ``filaments[0].segments[2].speed: must be > 0 mm/s; got -2``, raised as
@@ -147,6 +148,7 @@ class Filament(_Control):
     name: str = ""
     speed: Speed = 3.0
     active_side: Literal["outer", "inner"] | None = None
+    flip_length: float = Field(0.0, ge=0, description="mm over which active-side flips turn")
     start: Vec3 = (0.0, 0.0, 0.0)
     heading_deg: float = 0.0
     initial_nozzle_angle_deg: float = 0.0
@@ -193,7 +195,7 @@ class Filament(_Control):
             layer=self.layer,
         )
         if self.active_side is not None:
-            alpha = active_side_angle(path, self.active_side)
+            alpha = active_side_angle(path, self.active_side, self.flip_length)
             return PrintProgram.from_interface_angle(path, speed, alpha, **kw)
         h = path.heading
         psi_v = np.concatenate([[h[0]], 0.5 * (h[1:] + h[:-1]), [h[-1]]])
