@@ -55,9 +55,7 @@ class Network:
         if len(edges) == 0:
             raise InvalidDesignError("Network.edges", "needs at least one segment")
         if edges.min() < 0 or edges.max() >= len(nodes):
-            raise InvalidDesignError(
-                "Network.edges", f"indices must lie in [0, {len(nodes) - 1}]"
-            )
+            raise InvalidDesignError("Network.edges", f"indices must lie in [0, {len(nodes) - 1}]")
         loops = edges[:, 0] == edges[:, 1]
         if loops.any():
             raise InvalidDesignError(

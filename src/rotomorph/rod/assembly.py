@@ -33,8 +33,11 @@ def _transport(u, ta, tb):
     ua = _dot(u, ta)
     un = _dot(u, n1)
     ub = _dot(u, b)
-    return (ua * tb[0] + un * n2[0] + ub * b[0], ua * tb[1] + un * n2[1] + ub * b[1],
-            ua * tb[2] + un * n2[2] + ub * b[2])
+    return (
+        ua * tb[0] + un * n2[0] + ub * b[0],
+        ua * tb[1] + un * n2[1] + ub * b[1],
+        ua * tb[2] + un * n2[2] + ub * b[2],
+    )
 
 
 @njit(cache=_CACHE)
@@ -89,13 +92,34 @@ def reference_twist(st_edge_e, st_edge_f, st_sign_e, st_sign_f, t, d1, mref_old,
 
 @njit(cache=_CACHE)
 def assemble(
-    pos, theta, m1, m2, mref,
-    st_nodes, st_edge_e, st_edge_f, st_sign_e, st_sign_f,
-    st_B1, st_B2, st_C, st_voronoi, st_k1bar, st_k2bar, st_taubar,
-    edges, axial, rest,
-    pos_dof, theta_dof, ndof,
-    need_grad, need_hess,
-    grad_out, st_hess, ed_hess,
+    pos,
+    theta,
+    m1,
+    m2,
+    mref,
+    st_nodes,
+    st_edge_e,
+    st_edge_f,
+    st_sign_e,
+    st_sign_f,
+    st_B1,
+    st_B2,
+    st_C,
+    st_voronoi,
+    st_k1bar,
+    st_k2bar,
+    st_taubar,
+    edges,
+    axial,
+    rest,
+    pos_dof,
+    theta_dof,
+    ndof,
+    need_grad,
+    need_hess,
+    grad_out,
+    st_hess,
+    ed_hess,
 ):
     """Total elastic energy (N mm); gradient into ``grad_out`` (ndof,); local Hessians.
 
@@ -124,9 +148,27 @@ def assemble(
         m2f = (sf * m2[fb, 0], sf * m2[fb, 1], sf * m2[fb, 2])
         tw = sf * theta[fb] - se * theta[ea] + mref[s]
         en, _, _ = bend_twist_stencil(
-            _row(pos, n0), _row(pos, n1), _row(pos, n2), _row(m1, ea), m2e, _row(m1, fb), m2f,
-            tw, st_B1[s], st_B2[s], st_C[s], st_voronoi[s], st_k1bar[s], st_k2bar[s],
-            st_taubar[s], g, H, need_grad, need_hess, D, gk,
+            _row(pos, n0),
+            _row(pos, n1),
+            _row(pos, n2),
+            _row(m1, ea),
+            m2e,
+            _row(m1, fb),
+            m2f,
+            tw,
+            st_B1[s],
+            st_B2[s],
+            st_C[s],
+            st_voronoi[s],
+            st_k1bar[s],
+            st_k2bar[s],
+            st_taubar[s],
+            g,
+            H,
+            need_grad,
+            need_hess,
+            D,
+            gk,
         )
         energy += en
         if need_grad:
@@ -138,16 +180,21 @@ def assemble(
             grad_out[theta_dof[fb]] += sf * g[7]
         if need_hess:
             for i in range(11):
-                si = se if i == 3 else (sf if i == 7 else 1.0)
                 for j in range(11):
-                    sj = se if j == 3 else (sf if j == 7 else 1.0)
-                    st_hess[s, i, j] = si * sj * H[i, j]
+                    st_hess[s, i, j] = H[i, j]
+            # twist-angle rows and columns in the edges' own orientation
+            for k in range(11):
+                st_hess[s, 3, k] *= se
+                st_hess[s, k, 3] *= se
+                st_hess[s, 7, k] *= sf
+                st_hess[s, k, 7] *= sf
     H6 = np.empty((6, 6))
     for j in range(edges.shape[0]):
         a = edges[j, 0]
         b = edges[j, 1]
-        energy += stretch_edge(_row(pos, a), _row(pos, b), axial[j], rest[j], g6, H6,
-                               need_grad, need_hess)
+        energy += stretch_edge(
+            _row(pos, a), _row(pos, b), axial[j], rest[j], g6, H6, need_grad, need_hess
+        )
         if need_grad:
             for k in range(3):
                 grad_out[pos_dof[a] + k] += g6[k]
@@ -208,9 +255,30 @@ def scatter_sparse(st_hess, st_slot, ed_hess, ed_slot, data):
 
 @njit(cache=_CACHE)
 def evaluate_network(
-    pos, theta, t_base, d1_base, mref_base, t, d1, m1, m2, mref,
-    edges, st_nodes, st_edges, st_signs, st_params, ed_params, pos_dof, theta_dof, ndof,
-    need_grad, need_hess, grad_out, st_hess, ed_hess,
+    pos,
+    theta,
+    t_base,
+    d1_base,
+    mref_base,
+    t,
+    d1,
+    m1,
+    m2,
+    mref,
+    edges,
+    st_nodes,
+    st_edges,
+    st_signs,
+    st_params,
+    ed_params,
+    pos_dof,
+    theta_dof,
+    ndof,
+    need_grad,
+    need_hess,
+    grad_out,
+    st_hess,
+    ed_hess,
 ):
     """Frames transported from the base, reference twists, then :func:`assemble`.
 
@@ -220,14 +288,37 @@ def evaluate_network(
     per-call overhead of many array arguments out of the Newton loop.
     """
     transport_frames(pos, edges, t_base, d1_base, t, d1)
-    reference_twist(st_edges[:, 0], st_edges[:, 1], st_signs[:, 0], st_signs[:, 1], t, d1,
-                    mref_base, mref)
+    reference_twist(
+        st_edges[:, 0], st_edges[:, 1], st_signs[:, 0], st_signs[:, 1], t, d1, mref_base, mref
+    )
     material_frames(t, d1, theta, m1, m2)
     return assemble(
-        pos, theta, m1, m2, mref,
-        st_nodes, st_edges[:, 0], st_edges[:, 1], st_signs[:, 0], st_signs[:, 1],
-        st_params[:, 0], st_params[:, 1], st_params[:, 2], st_params[:, 3],
-        st_params[:, 4], st_params[:, 5], st_params[:, 6],
-        edges, ed_params[:, 0], ed_params[:, 1],
-        pos_dof, theta_dof, ndof, need_grad, need_hess, grad_out, st_hess, ed_hess,
+        pos,
+        theta,
+        m1,
+        m2,
+        mref,
+        st_nodes,
+        st_edges[:, 0],
+        st_edges[:, 1],
+        st_signs[:, 0],
+        st_signs[:, 1],
+        st_params[:, 0],
+        st_params[:, 1],
+        st_params[:, 2],
+        st_params[:, 3],
+        st_params[:, 4],
+        st_params[:, 5],
+        st_params[:, 6],
+        edges,
+        ed_params[:, 0],
+        ed_params[:, 1],
+        pos_dof,
+        theta_dof,
+        ndof,
+        need_grad,
+        need_hess,
+        grad_out,
+        st_hess,
+        ed_hess,
     )

@@ -130,8 +130,27 @@ def _place_theta(H, w, col, De, Df):
 
 @njit(cache=_CACHE)
 def bend_twist_stencil(
-    x0, x1, x2, m1e, m2e, m1f, m2f, twist, B1, B2, C, voronoi, k1bar, k2bar, taubar,
-    grad, hess, need_grad, need_hess, D, gk,
+    x0,
+    x1,
+    x2,
+    m1e,
+    m2e,
+    m1f,
+    m2f,
+    twist,
+    B1,
+    B2,
+    C,
+    voronoi,
+    k1bar,
+    k2bar,
+    taubar,
+    grad,
+    hess,
+    need_grad,
+    need_hess,
+    D,
+    gk,
 ):
     """Energy (N mm), gradient and Hessian of one bend-twist stencil.
 
@@ -139,7 +158,9 @@ def bend_twist_stencil(
     orientation). ``twist`` is the current integrated twist ``theta_f - theta_e + m_ref`` (rad);
     natural values are integrated (dimensionless). ``grad`` (11,) and ``hess`` (11, 11) are
     overwritten when requested; ``D`` (3, 3, 3) and ``gk`` (3, 11) are work buffers.
-    Returns ``(energy, kappa1, kappa2)``.
+    ``need_hess`` 1 gives the exact Hessian, 2 its Gauss–Newton part
+    ``sum_k w_k grad(k) grad(k)^T`` (positive semidefinite, used where the exact Hessian is
+    indefinite). Returns ``(energy, kappa1, kappa2)``.
     """
     e = (x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2])
     f = (x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2])
@@ -201,8 +222,11 @@ def bend_twist_stencil(
     w3 = inv_l * C
     for i in range(11):
         for j in range(11):
-            hess[i, j] = (w1 * gk[0, i] * gk[0, j] + w2 * gk[1, i] * gk[1, j]
-                          + w3 * gk[2, i] * gk[2, j])
+            hess[i, j] = (
+                w1 * gk[0, i] * gk[0, j] + w2 * gk[1, i] * gk[1, j] + w3 * gk[2, i] * gk[2, j]
+            )
+    if need_hess == 2:
+        return energy, kappa1, kappa2
     ne2 = ne * ne
     nf2 = nf * nf
     nef = ne * nf
@@ -231,11 +255,21 @@ def bend_twist_stencil(
         hess[3, 3] += a1 * (-0.5 * _dot(kb, m2e))
         hess[7, 7] += a1 * (-0.5 * _dot(kb, m2f))
         c = 0.5 * _dot(kb, m1e)
-        _place_theta(hess, a1, 3, _lin(c / ne, tt, -ic / ne, _cross(tf, m1e)),
-                     _lin(c / nf, tt, ic / nf, _cross(te, m1e)))
+        _place_theta(
+            hess,
+            a1,
+            3,
+            _lin(c / ne, tt, -ic / ne, _cross(tf, m1e)),
+            _lin(c / nf, tt, ic / nf, _cross(te, m1e)),
+        )
         c = 0.5 * _dot(kb, m1f)
-        _place_theta(hess, a1, 7, _lin(c / ne, tt, -ic / ne, _cross(tf, m1f)),
-                     _lin(c / nf, tt, ic / nf, _cross(te, m1f)))
+        _place_theta(
+            hess,
+            a1,
+            7,
+            _lin(c / ne, tt, -ic / ne, _cross(tf, m1f)),
+            _lin(c / nf, tt, ic / nf, _cross(te, m1f)),
+        )
     # ---- kappa2 second derivatives ----
     if a2 != 0.0:
         _clear(D, 0)
@@ -261,11 +295,21 @@ def bend_twist_stencil(
         hess[3, 3] += a2 * (0.5 * _dot(kb, m1e))
         hess[7, 7] += a2 * (0.5 * _dot(kb, m1f))
         c = 0.5 * _dot(kb, m2e)
-        _place_theta(hess, a2, 3, _lin(c / ne, tt, -ic / ne, _cross(tf, m2e)),
-                     _lin(c / nf, tt, ic / nf, _cross(te, m2e)))
+        _place_theta(
+            hess,
+            a2,
+            3,
+            _lin(c / ne, tt, -ic / ne, _cross(tf, m2e)),
+            _lin(c / nf, tt, ic / nf, _cross(te, m2e)),
+        )
         c = 0.5 * _dot(kb, m2f)
-        _place_theta(hess, a2, 7, _lin(c / ne, tt, -ic / ne, _cross(tf, m2f)),
-                     _lin(c / nf, tt, ic / nf, _cross(te, m2f)))
+        _place_theta(
+            hess,
+            a2,
+            7,
+            _lin(c / ne, tt, -ic / ne, _cross(tf, m2f)),
+            _lin(c / nf, tt, ic / nf, _cross(te, m2f)),
+        )
     # ---- twist (reference twist) second derivatives ----
     if a3 != 0.0:
         _clear(D, 0)
@@ -276,12 +320,8 @@ def bend_twist_stencil(
         _cross_matrix(D, 2, 1.0 / (chi * nef), te)
         _outer(D, 2, -0.5 / nef, kb, tt, False)
         _place_edge_blocks(hess, a3, D)
-    # exact Hessian = symmetric part
-    for i in range(11):
-        for j in range(i + 1, 11):
-            v = 0.5 * (hess[i, j] + hess[j, i])
-            hess[i, j] = v
-            hess[j, i] = v
+    # The blocks are placed symmetrically (d2/de df and its transpose), so ``hess`` is the
+    # symmetric part of the Jacobian of the gradient: the exact Hessian with re-based frames.
     return energy, kappa1, kappa2
 
 
@@ -290,6 +330,7 @@ def stretch_edge(xi, xj, axial_stiffness, rest_length, grad, hess, need_grad, ne
     r"""Stretching energy :math:`\tfrac12 (EA/\bar l)(|e|-\bar l)^2` of one edge (N mm).
 
     Local order ``[xi (0:3), xj (3:6)]``; ``grad`` (6,) and ``hess`` (6, 6) are overwritten.
+    ``need_hess`` 2 drops the (indefinite under compression) transverse term.
     """
     e0 = xj[0] - xi[0]
     e1 = xj[1] - xi[1]
@@ -314,6 +355,8 @@ def stretch_edge(xi, xj, axial_stiffness, rest_length, grad, hess, need_grad, ne
             t = np.empty(3)
             t[0], t[1], t[2] = t0, t1, t2
             r = dl / n
+            if need_hess == 2:
+                r = max(r, 0.0)
             for i in range(3):
                 for j in range(3):
                     v = k * ((1.0 - r) * t[i] * t[j] + (r if i == j else 0.0))

@@ -108,16 +108,23 @@ class Model:
         net = self.network
         ne = net.n_edges
         set_ = object.__setattr__
-        for name in ("bending_stiffness1", "bending_stiffness2", "twist_stiffness",
-                     "axial_stiffness"):
+        for name in (
+            "bending_stiffness1",
+            "bending_stiffness2",
+            "twist_stiffness",
+            "axial_stiffness",
+        ):
             set_(self, name, _per_item(name, getattr(self, name), ne, positive=True))
         st = build_stencils(net)
         set_(self, "stencils", st)
         set_(self, "layout", dof_layout(net))
         t = net.nodes[net.edges[:, 1]] - net.nodes[net.edges[:, 0]]
         t = t / np.linalg.norm(t, axis=1, keepdims=True)
-        d = _default_directors(net) if self.directors is None else np.array(
-            self.directors, dtype=float)
+        d = (
+            _default_directors(net)
+            if self.directors is None
+            else np.array(self.directors, dtype=float)
+        )
         if d.shape != (ne, 3) or not np.isfinite(d).all():
             raise InvalidParameterError(
                 "Model.directors", f"must be a finite array of shape ({ne}, 3)"
@@ -135,8 +142,11 @@ class Model:
         rest = net.edge_lengths if self.rest_length is None else self.rest_length
         set_(self, "rest_length", _per_item("rest_length", rest, ne, positive=True))
         k1, k2, tw = self._reference_integrated()
-        for name, ref in (("natural_curvature1", k1), ("natural_curvature2", k2),
-                          ("natural_twist", tw)):
+        for name, ref in (
+            ("natural_curvature1", k1),
+            ("natural_curvature2", k2),
+            ("natural_twist", tw),
+        ):
             value = getattr(self, name)
             if value is None:
                 value = ref / self._reference_voronoi()
@@ -210,10 +220,23 @@ class Model:
         t /= np.linalg.norm(t, axis=1, keepdims=True)
         st = self.stencils
         mref = np.empty(st.count)
-        reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t,
-                        np.array(self.directors), np.zeros(st.count), mref)
-        return State(positions=x, theta=np.zeros(net.n_edges), tangents=t,
-                     directors=np.array(self.directors), reference_twist=mref)
+        reference_twist(
+            st.edge_e,
+            st.edge_f,
+            st.sign_e,
+            st.sign_f,
+            t,
+            np.array(self.directors),
+            np.zeros(st.count),
+            mref,
+        )
+        return State(
+            positions=x,
+            theta=np.zeros(net.n_edges),
+            tangents=t,
+            directors=np.array(self.directors),
+            reference_twist=mref,
+        )
 
     @classmethod
     def chain(cls, points: FloatArray, **kwargs: object) -> Model:

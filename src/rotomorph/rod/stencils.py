@@ -76,9 +76,11 @@ def build_stencils(network: Network) -> Stencils:
                 "Network.branch",
                 f"node {n} joins {k} segments but is not flagged as a branch node",
             )
-        pairs = [(inc[0], inc[1])] if k == 2 and not network.branch[n] else [
-            (inc[p], inc[q]) for p in range(k) for q in range(p + 1, k)
-        ]
+        pairs = (
+            [(inc[0], inc[1])]
+            if k == 2 and not network.branch[n]
+            else [(inc[p], inc[q]) for p in range(k) for q in range(p + 1, k)]
+        )
         for a, b in pairs:
             sa = 1.0 if edges[a, 1] == n else -1.0
             sb = 1.0 if edges[b, 0] == n else -1.0

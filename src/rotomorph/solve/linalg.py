@@ -1,25 +1,26 @@
 """Factorizations of symmetric matrices that report positive definiteness.
 
-Modified Newton needs to know whether ``H + shift * M`` is positive definite. Banded matrices
+Modified Newton needs to know whether ``H + diag(shift)`` is positive definite. Banded matrices
 (single rods) use a compiled banded Cholesky (:mod:`rotomorph.solve.banded`), which fails on a
-non-positive pivot.
-General sparse matrices (networks) use SuperLU in symmetric mode with a symmetric fill-reducing
-ordering and no pivoting (``diag_pivot_thresh = 0``): then ``P A P^T = L U`` with
-``U = D L^T``, so by Sylvester's law of inertia ``A`` is positive definite exactly when every
-diagonal entry of ``U`` is positive.
+non-positive pivot. General sparse matrices (networks) use SuperLU in symmetric mode with a
+symmetric fill-reducing ordering and no pivoting (``diag_pivot_thresh = 0``): then
+``P A P^T = L U`` with ``U = D L^T``, so by Sylvester's law of inertia ``A`` is positive definite
+exactly when every diagonal entry of ``U`` is positive. Dense matrices use LAPACK ``potrf``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numba import njit
 from scipy.linalg import lapack
 
 from rotomorph._typing import FloatArray
-from rotomorph.solve.banded import shifted_banded_solve
+from rotomorph.solve.banded import banded_cholesky, banded_cholesky_solve
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,19 +51,58 @@ class BandedMatrix:
         return out
 
 
-def solve_shifted(
-    H: BandedMatrix | sp.csc_matrix | FloatArray, rhs: FloatArray, shift: FloatArray
-) -> FloatArray | None:
-    """Solve ``(H + diag(shift)) x = rhs`` if the shifted matrix is positive definite.
+@njit(cache=True)
+def _banded_matvec(ab, u, x):  # pragma: no cover - compiled
+    n = ab.shape[1]
+    y = np.zeros(n)
+    for j in range(n):
+        y[j] += ab[u, j] * x[j]
+        for i in range(max(0, j - u), j):
+            a = ab[u + i - j, j]
+            y[i] += a * x[j]
+            y[j] += a * x[i]
+    return y
 
-    Returns
-    -------
-    ndarray or None
-        The solution, or ``None`` when the shifted matrix is not positive definite.
-    """
+
+def diagonal(H: Any) -> FloatArray:
+    """Main diagonal of a banded, sparse or dense symmetric matrix."""
     if isinstance(H, BandedMatrix):
-        ok, x = shifted_banded_solve(H.ab, H.u, shift, rhs, np.empty_like(H.ab))
-        return x if ok else None
+        return H.diagonal
+    return np.asarray(H.diagonal())
+
+
+def matvec(H: Any, x: FloatArray) -> FloatArray:
+    """``H @ x`` for a banded, sparse or dense symmetric matrix."""
+    if isinstance(H, BandedMatrix):
+        return _banded_matvec(H.ab, H.u, x)
+    return np.asarray(H @ x)
+
+
+class Factor:
+    """A Cholesky-type factorization of a positive definite matrix; ``solve(rhs)``."""
+
+    def __init__(self, kind: str, data: Any) -> None:
+        self._kind, self._data = kind, data
+
+    def solve(self, rhs: FloatArray) -> FloatArray:
+        """Solve with the factored matrix."""
+        if self._kind == "banded":
+            c, u = self._data
+            return banded_cholesky_solve(c, u, rhs)
+        if self._kind == "sparse":
+            return self._data.solve(rhs)
+        x, _ = lapack.dpotrs(self._data, rhs, lower=0)
+        return x
+
+
+def factorize(H: Any, shift: FloatArray) -> Factor | None:
+    """Factor ``H + diag(shift)``; ``None`` when it is not positive definite."""
+    if isinstance(H, BandedMatrix):
+        work = H.ab.copy(order="F")
+        work[H.u] += shift
+        if not banded_cholesky(work, H.u):
+            return None
+        return Factor("banded", (work, H.u))
     if sp.issparse(H):
         A = (H + sp.diags(shift)).tocsc()
         try:
@@ -74,15 +114,20 @@ def solve_shifted(
             )
         except RuntimeError:  # exactly singular
             return None
-        if not (np.all(np.isfinite(lu.U.diagonal())) and np.all(lu.U.diagonal() > 0)):
-            return None
+        dg = lu.U.diagonal()
         # a row interchange would invalidate the inertia argument
-        if not np.array_equal(lu.perm_r, lu.perm_c):
+        if not (
+            np.all(np.isfinite(dg)) and np.all(dg > 0) and np.array_equal(lu.perm_r, lu.perm_c)
+        ):
             return None
-        return lu.solve(rhs)
-    A = np.asarray(H) + np.diag(shift)
-    c, info = lapack.dpotrf(A, lower=0)
+        return Factor("sparse", lu)
+    c, info = lapack.dpotrf(np.asarray(H) + np.diag(shift), lower=0)
     if info != 0:
         return None
-    x, info = lapack.dpotrs(c, rhs, lower=0)
-    return x if info == 0 else None
+    return Factor("dense", c)
+
+
+def solve_shifted(H: Any, rhs: FloatArray, shift: FloatArray) -> FloatArray | None:
+    """Solve ``(H + diag(shift)) x = rhs`` if the shifted matrix is positive definite."""
+    f = factorize(H, shift)
+    return None if f is None else f.solve(rhs)

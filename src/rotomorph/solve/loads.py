@@ -82,8 +82,9 @@ class Gravity:
     def line_weight(self, n_edges: int) -> FloatArray:
         """Net weight per unit length of each edge (N/mm), buoyancy subtracted."""
         rho = (self.density - self.fluid_density) * 1e-6  # kg/mm³
-        return np.broadcast_to(rho * np.asarray(self.area, float) * self.acceleration,
-                               (n_edges,)).astype(float)
+        return np.broadcast_to(
+            rho * np.asarray(self.area, float) * self.acceleration, (n_edges,)
+        ).astype(float)
 
 
 @dataclass(frozen=True)

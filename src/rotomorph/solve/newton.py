@@ -23,7 +23,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
-from rotomorph.solve.linalg import solve_shifted
+from rotomorph.solve.linalg import diagonal, factorize, matvec
 from rotomorph.solve.result import NewtonResult, Status
 
 log = logging.getLogger(__name__)
@@ -69,6 +69,11 @@ class NewtonOptions:
         Sufficient-decrease constant of the line search.
     max_backtracks
         Halvings allowed in one line search before the shift is raised.
+    curvature_iterations
+        Inverse iterations used to find a direction of negative curvature when the Hessian is
+        indefinite (0 disables it).
+    curvature_shift
+        Relative shift above which the Hessian counts as indefinite for that search.
     """
 
     max_iterations: int = 200
@@ -76,6 +81,8 @@ class NewtonOptions:
     decrement_tol: float = 1e-16
     armijo: float = 1e-4
     max_backtracks: int = 40
+    curvature_iterations: int = 6
+    curvature_shift: float = 1e-9
 
     def __post_init__(self) -> None:
         if self.max_iterations < 1:
@@ -99,10 +106,11 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     w = obj.weights()
     fscale = max(float(np.linalg.norm(w * g)), obj.force_scale, 1e-300)
     escale = max(obj.energy_scale, abs(f), 1e-300)
-    diag = H.diagonal if hasattr(H, "u") else np.asarray(H.diagonal())
+    diag = diagonal(H)
     tau_unit = max(float(np.max(np.abs(diag) / M)) if diag.size else 1.0, 1e-300)
     tau_min = 1e-14 * tau_unit
     tau = 0.0
+    first_try_ok = True
     history: list[tuple[float, float, float, float]] = []
     n_fact = 0
     dec = np.inf
@@ -117,28 +125,49 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             status = Status.CONVERGED
             break
         it += 1
-        # modified Newton: smallest shift (from a warm start) giving a positive definite matrix
-        tau = 0.0 if tau <= 1e3 * tau_min else tau / 10.0
-        while True:
-            n_fact += 1
-            d = solve_shifted(H, -g, tau * M)
-            if d is not None and np.all(np.isfinite(d)):
-                break
-            tau = max(10.0 * tau, 1e-8 * tau_unit)
-            if tau > 1e12 * tau_unit:
-                status = Status.NOT_FINITE
-                return _result(x, status, it, n_fact, f, res, dec, history)
+        # 1) Newton with the exact Hessian (a tiny shift covers free rigid-body modes)
+        pure = True
+        n_fact += 1
+        fac = factorize(H, tau_min * M)
+        d = None if fac is None else fac.solve(-g)
+        if d is None or not np.all(np.isfinite(d)):
+            pure = False
+            # 2) indefinite: the objective's convex (Gauss–Newton) Hessian if it has one,
+            #    else the exact one; then the smallest uniform shift that makes it positive
+            #    definite, warm-started and relaxed only after a first try succeeded
+            Hc = obj.convex_hessian(x) if hasattr(obj, "convex_hessian") else H
+            if first_try_ok:
+                tau = tau_min if tau <= 1e3 * tau_min else tau / 10.0
+            tau = max(tau, tau_min)
+            first_try_ok = True
+            while True:
+                n_fact += 1
+                fac = factorize(Hc, tau * M)
+                d = None if fac is None else fac.solve(-g)
+                if d is not None and np.all(np.isfinite(d)):
+                    break
+                first_try_ok = False
+                tau = max(10.0 * tau, 1e-8 * tau_unit)
+                if tau > 1e12 * tau_unit:
+                    status = Status.NOT_FINITE
+                    return _result(x, status, it, n_fact, f, res, dec, history)
+            if Hc is H and tau > opt.curvature_shift * tau_unit:
+                v = _negative_curvature_direction(fac, H, M, g, tau, opt.curvature_iterations)
+                if v is not None:
+                    d = d + _scale_curvature_step(obj, x, v, d, M)
+        if hasattr(obj, "project"):
+            d = obj.project(d)
         slope = float(g @ d)
         dec = -0.5 * slope / escale
-        if tau == 0.0 and dec <= opt.decrement_tol:
-            x = obj.retract(x, d, 1.0)
+        if pure and dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
+            x = obj.retract(x, d, min(1.0, obj.max_step(x, d)) if hasattr(obj, "max_step") else 1.0)
             obj.accept(x)
             f, g, H = obj.evaluate(x, True, True)
             res = float(np.linalg.norm(w * g)) / fscale
             history.append((f, res, 1.0, tau))
             status = Status.CONVERGED
             return _result(x, status, it, n_fact, f, res, dec, history)
-        alpha = 1.0
+        alpha = min(1.0, obj.max_step(x, d)) if hasattr(obj, "max_step") else 1.0
         accepted = False
         for _ in range(opt.max_backtracks):
             xt = obj.retract(x, d, alpha)
@@ -153,6 +182,8 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         if not accepted:
             if tau < 1e10 * tau_unit:
                 tau = max(100.0 * tau, 1e-6 * tau_unit)
+                first_try_ok = False
+                H = obj.convex_hessian(x) if hasattr(obj, "convex_hessian") else H
                 history.append((f, res, 0.0, tau))
                 continue
             status = Status.LINE_SEARCH_FAILED
@@ -161,16 +192,56 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         obj.accept(x)
         f, g, H = obj.evaluate(x, True, True)
         history.append((f, float(np.linalg.norm(w * g)) / fscale, alpha, tau))
-        log.debug("newton %d: E=%.6e res=%.3e alpha=%.3g tau=%.3g", it, f, history[-1][1],
-                  alpha, tau)
+        log.debug(
+            "newton %d: E=%.6e res=%.3e alpha=%.3g tau=%.3g", it, f, history[-1][1], alpha, tau
+        )
     res = float(np.linalg.norm(w * g)) / fscale
     return _result(x, status, it, n_fact, f, res, dec, history)
 
 
+def _negative_curvature_direction(fac, H, M, g, tau, iterations):  # type: ignore[no-untyped-def]
+    """A unit (M-norm) direction of negative curvature pointing downhill, or None.
+
+    Inverse iteration with the shifted factor ``(H + tau M)^-1 M`` converges to the
+    eigenvector of ``H v = lambda M v`` with the most negative ``lambda`` (the factor is
+    positive definite, so ``lambda + tau > 0``). Adding it to the modified-Newton step moves
+    off saddle points (e.g. a straight, twisted rod that should coil) instead of creeping
+    along them (Moré & Sorensen, Math. Programming 16, 1979). The start vector is fixed, so
+    the result is reproducible.
+    """
+    if iterations <= 0:
+        return None
+    n = len(g)
+    v = np.cos(np.arange(n) * 2.399963229728653)  # deterministic, broadband start
+    for _ in range(iterations):
+        v = fac.solve(M * v)
+        nv = np.sqrt(float(v @ (M * v)))
+        if not np.isfinite(nv) or nv == 0:
+            return None
+        v /= nv
+    lam = float(v @ matvec(H, v))
+    if not lam < -0.1 * tau:
+        return None
+    return -v if float(g @ v) > 0 else v
+
+
+def _scale_curvature_step(obj, x, v, d, M):  # type: ignore[no-untyped-def]
+    """Scale ``v`` to the larger of the step's M-norm and a physical move (objective-defined)."""
+    scale = np.sqrt(float(d @ (M * d)))
+    if hasattr(obj, "curvature_step_scale"):
+        scale = max(scale, obj.curvature_step_scale(x, v))
+    return scale * v
+
+
 def _result(x, status, it, n_fact, f, res, dec, history) -> NewtonResult:  # type: ignore[no-untyped-def]
     return NewtonResult(
-        x=x, status=status, iterations=it, factorizations=n_fact, energy=float(f),
-        residual=float(res), decrement=float(dec),
+        x=x,
+        status=status,
+        iterations=it,
+        factorizations=n_fact,
+        energy=float(f),
+        residual=float(res),
+        decrement=float(dec),
         history=np.array(history, dtype=float).reshape(-1, 4),
     )
 

@@ -23,7 +23,11 @@ from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
 from rotomorph.solve.linalg import BandedMatrix
 from rotomorph.solve.loads import Loads, Supports
-from rotomorph.solve.retraction import EdgeRotationRetraction
+from rotomorph.solve.retraction import (
+    EdgeRotationRetraction,
+    max_edge_rotation,
+    remove_rigid_motion,
+)
 
 BANDED_LIMIT = 64  # half-bandwidth above which the sparse path is used
 
@@ -60,21 +64,29 @@ class RodObjective:
         b1, b2, c = model.stencil_stiffness
         self._stiff = (np.ascontiguousarray(b1), np.ascontiguousarray(b2), np.ascontiguousarray(c))
         k1, k2, tw = model.integrated_natural()
-        self._natural = (np.ascontiguousarray(k1), np.ascontiguousarray(k2),
-                         np.ascontiguousarray(tw))
+        self._natural = (
+            np.ascontiguousarray(k1),
+            np.ascontiguousarray(k2),
+            np.ascontiguousarray(tw),
+        )
         self._vor = np.ascontiguousarray(model.voronoi_length)
         self._st_edges = np.ascontiguousarray(np.stack([st.edge_e, st.edge_f], axis=1))
         self._st_signs = np.ascontiguousarray(np.stack([st.sign_e, st.sign_f], axis=1))
         self._st_params = np.ascontiguousarray(np.stack([b1, b2, c, self._vor, k1, k2, tw], 1))
         self._ed_params = np.ascontiguousarray(
-            np.stack([model.axial_stiffness, model.rest_length], axis=1))
+            np.stack([model.axial_stiffness, model.rest_length], axis=1)
+        )
         self._external = self._external_forces(loads)
         self._has_forces = bool(np.any(self._external))
         self._st_nodes = np.ascontiguousarray(st.nodes)
         self._moment_edges, self._moments = self._edge_moments(loads)
-        if supports.is_free and np.linalg.norm(self._external[self._pos_index].reshape(-1, 3).sum(0)) > 0:
+        if (
+            supports.is_free
+            and np.linalg.norm(self._external[self._pos_index].reshape(-1, 3).sum(0)) > 0
+        ):
             raise InvalidParameterError(
-                "Supports", "a free body under a net external force has no equilibrium; "
+                "Supports",
+                "a free body under a net external force has no equilibrium; "
                 "pin or clamp at least one node",
             )
         # work buffers
@@ -87,6 +99,7 @@ class RodObjective:
         self._m2 = np.empty((ne, 3))
         self._mref = np.empty(st.count)
         self._setup_matrix()
+        self._fixed_mask = fixed
         self.set_base(state)
         self._setup_scales(loads)
 
@@ -124,16 +137,23 @@ class RodObjective:
     def _setup_matrix(self) -> None:
         red = self._reduced
         rs, re_ = red[self._st_dofs], red[self._ed_dofs]
-        spans = [np.max(np.abs(r[:, :, None] - r[:, None, :]) * ((r[:, :, None] >= 0)
-                 & (r[:, None, :] >= 0))) for r in (rs, re_) if r.size]
+        spans = [
+            np.max(
+                np.abs(r[:, :, None] - r[:, None, :])
+                * ((r[:, :, None] >= 0) & (r[:, None, :] >= 0))
+            )
+            for r in (rs, re_)
+            if r.size
+        ]
         self.bandwidth = int(max(spans)) if spans else 0
         nfree = len(self.free)
         self.banded = self.bandwidth <= BANDED_LIMIT
         if self.banded:
             self._ab = np.zeros((self.bandwidth + 1, nfree), order="F")
             return
-        rows = np.concatenate([np.repeat(rs, 11, axis=1).ravel(),
-                               np.repeat(re_, 6, axis=1).ravel()])
+        rows = np.concatenate(
+            [np.repeat(rs, 11, axis=1).ravel(), np.repeat(re_, 6, axis=1).ravel()]
+        )
         cols = np.concatenate([np.tile(rs, (1, 11)).ravel(), np.tile(re_, (1, 6)).ravel()])
         ok = (rows >= 0) & (cols >= 0)
         keys = np.where(ok, cols * nfree + rows, -1)
@@ -174,9 +194,12 @@ class RodObjective:
         for end in (0, 1):
             for k in range(3):
                 np.add.at(m, lay.pos[net.edges[:, end]] + k, half)
-        m[lay.theta] = self.model.rest_length * (self.model.twist_stiffness
-                                                 / self.model.axial_stiffness)
+        # a twist angle is weighted like the rotation of its edge (length^3), so that the
+        # shift damps twisting and bending rotations alike at every mesh size
+        m[lay.theta] = self.model.rest_length**3
         self._metric = m[self.free]
+        self._node_metric = m[lay.pos]
+        self._free_body = not self._fixed_mask.any()
         wt = np.ones(lay.count)
         wt[lay.theta] = 1.0 / lmean
         self._weights = wt[self.free]
@@ -185,6 +208,7 @@ class RodObjective:
     def set_base(self, state: State) -> None:
         """Make ``state`` the base of later evaluations."""
         self.base = state
+        self._last = None
         u = np.empty(self.model.layout.count)
         u[self._pos_index] = state.positions.ravel()
         u[self._theta_index] = state.theta
@@ -211,13 +235,28 @@ class RodObjective:
         transport_frames(pos, self._edges, self.base.tangents, self.base.directors, t, d1)
         st = self.model.stencils
         mref = np.empty(st.count)
-        reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1,
-                        self.base.reference_twist, mref)
+        reference_twist(
+            st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1, self.base.reference_twist, mref
+        )
         return State(positions=pos, theta=theta, tangents=t, directors=d1, reference_twist=mref)
 
     def accept(self, q: FloatArray) -> None:
         """Re-base at ``q`` (time-parallel transport of the frames)."""
-        self.set_base(self.state(q))
+        last = self._last
+        if last is not None and last[0] is q:
+            # the line search has just evaluated q: reuse its transported frames
+            _, pos, theta = last
+            self.set_base(
+                State(
+                    positions=pos,
+                    theta=theta,
+                    tangents=self._t.copy(),
+                    directors=self._d1.copy(),
+                    reference_twist=self._mref.copy(),
+                )
+            )
+        else:
+            self.set_base(self.state(q))
 
     # ------------------------------------------------------------------ objective
     def evaluate(self, q: FloatArray, need_grad: bool, need_hess: bool):  # type: ignore[no-untyped-def]
@@ -226,15 +265,47 @@ class RodObjective:
         u[self.free] = q
         pos = u[self._pos_index].reshape(-1, 3)
         theta = u[self._theta_index]
+        self._last = (q, pos, theta)
         base = self.base
         lay = self.model.layout
-        energy = evaluate_network(
-            pos, theta, base.tangents, base.directors, base.reference_twist,
-            self._t, self._d1, self._m1, self._m2, self._mref,
-            self._edges, self._st_nodes, self._st_edges, self._st_signs, self._st_params,
-            self._ed_params, lay.pos, lay.theta, lay.count,
-            need_grad, need_hess, self._grad, self._st_hess, self._ed_hess,
+        try:
+            energy = self._evaluate_network(pos, theta, need_grad, need_hess)
+        except ZeroDivisionError:
+            if need_grad or need_hess:
+                raise
+            return np.inf, None, None
+        return self._finish(u, pos, theta, energy, need_grad, need_hess)
+
+    def _evaluate_network(self, pos, theta, need_grad, need_hess):  # type: ignore[no-untyped-def]
+        base, lay = self.base, self.model.layout
+        return evaluate_network(
+            pos,
+            theta,
+            base.tangents,
+            base.directors,
+            base.reference_twist,
+            self._t,
+            self._d1,
+            self._m1,
+            self._m2,
+            self._mref,
+            self._edges,
+            self._st_nodes,
+            self._st_edges,
+            self._st_signs,
+            self._st_params,
+            self._ed_params,
+            lay.pos,
+            lay.theta,
+            lay.count,
+            need_grad,
+            need_hess,
+            self._grad,
+            self._st_hess,
+            self._ed_hess,
         )
+
+    def _finish(self, u, pos, theta, energy, need_grad, need_hess):  # type: ignore[no-untyped-def]
         grad = self._grad
         if self._has_forces:
             energy -= float(self._external @ u)
@@ -282,13 +353,64 @@ class RodObjective:
 
     def _hessian(self):  # type: ignore[no-untyped-def]
         if self.banded:
-            scatter_banded(self._st_hess, self._st_dofs, self._ed_hess, self._ed_dofs,
-                           self._reduced, self.bandwidth, self._ab)
+            scatter_banded(
+                self._st_hess,
+                self._st_dofs,
+                self._ed_hess,
+                self._ed_dofs,
+                self._reduced,
+                self.bandwidth,
+                self._ab,
+            )
             return BandedMatrix(self._ab.copy(order="F"), self.bandwidth)
         scatter_sparse(self._st_hess, self._st_slot, self._ed_hess, self._ed_slot, self._data)
         n = len(self.free)
         indices, indptr = self._csc_pattern
         return sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
+
+    def project(self, d: FloatArray) -> FloatArray:
+        """Remove the rigid motion from a step of a free body (M-orthogonal projection).
+
+        Rigid motions of an unsupported network are exact zero-energy modes; any component a
+        factorization puts along them is round-off. Translation and rotation about the
+        metric-weighted centroid are M-orthogonal, so the projection is closed-form. With any
+        support the step is returned unchanged (the remaining modes are handled by the shift).
+        """
+        if not self._free_body:
+            return d
+        du = np.zeros(self.model.layout.count)
+        du[self.free] = d
+        dx = np.ascontiguousarray(du[self._pos_index].reshape(-1, 3))
+        remove_rigid_motion(self.base.positions, dx, self._node_metric)
+        du[self._pos_index] = dx.ravel()
+        return du[self.free]
+
+    def curvature_step_scale(self, q: FloatArray, v: FloatArray) -> float:
+        """Multiple of ``v`` that turns the most-turned edge by 0.2 rad."""
+        angle = self._max_edge_rotation(v)
+        return 0.2 / angle if angle > 0 else 0.0
+
+    def max_step(self, q: FloatArray, d: FloatArray) -> float:
+        """Largest step fraction that turns no edge by more than one radian."""
+        angle = self._max_edge_rotation(d)
+        return 1.0 if angle <= 1.0 else 1.0 / angle
+
+    def _max_edge_rotation(self, d: FloatArray) -> float:
+        du = np.zeros(self.model.layout.count)
+        du[self.free] = d
+        return float(
+            max_edge_rotation(
+                self.base.positions,
+                np.ascontiguousarray(du[self._pos_index].reshape(-1, 3)),
+                self._edges,
+            )
+        )
+
+    def convex_hessian(self, q: FloatArray):  # type: ignore[no-untyped-def]
+        """Gauss–Newton Hessian at ``q``: positive semidefinite, for indefinite iterates."""
+        pos, theta = self._unpack(q)
+        self._evaluate_network(pos, theta, False, 2)
+        return self._hessian()
 
     def metric(self) -> FloatArray:
         """Lumped metric: Voronoi length per position DOF, length x C/EA per twist angle."""

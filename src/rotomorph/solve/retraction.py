@@ -94,8 +94,10 @@ class EdgeRotationRetraction:
         self.free = np.flatnonzero(~fixed)
         e = len(edges)
         B = sp.csr_matrix(
-            (np.r_[-np.ones(e), np.ones(e)], (np.r_[np.arange(e), np.arange(e)],
-                                              np.r_[edges[:, 0], edges[:, 1]])),
+            (
+                np.r_[-np.ones(e), np.ones(e)],
+                (np.r_[np.arange(e), np.arange(e)], np.r_[edges[:, 0], edges[:, 1]]),
+            ),
             shape=(e, n_nodes),
         )
         self._Bd = B[:, self.fixed].tocsc()
@@ -109,8 +111,19 @@ class EdgeRotationRetraction:
         out = np.empty_like(x)
         if self._tree is not None:
             root, order, parent, parent_edge, sign = self._tree
-            _accumulate_tree(x, dx, alpha, root, self.anchor_first, order, parent, parent_edge,
-                             sign, self._target, out)
+            _accumulate_tree(
+                x,
+                dx,
+                alpha,
+                root,
+                self.anchor_first,
+                order,
+                parent,
+                parent_edge,
+                sign,
+                self._target,
+                out,
+            )
             return out
         xd = x[self.fixed] + (alpha * dx[self.fixed] if self.anchor_first else 0.0)
         out[self.fixed] = xd
@@ -144,3 +157,60 @@ def _bfs_tree(edges: IntArray, n: int, root: int):  # type: ignore[no-untyped-de
     if not seen.all():
         return None
     return np.array(order, dtype=np.int64), parent, parent_edge, sign
+
+
+@njit(cache=True)
+def max_edge_rotation(x, dx, edges):  # pragma: no cover - compiled
+    """Largest rotation angle (rad, linearised) that the step ``dx`` gives an edge."""
+    worst = 0.0
+    for j in range(edges.shape[0]):
+        a = edges[j, 0]
+        b = edges[j, 1]
+        e0, e1, e2 = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
+        d0, d1, d2 = dx[b, 0] - dx[a, 0], dx[b, 1] - dx[a, 1], dx[b, 2] - dx[a, 2]
+        ln2 = e0 * e0 + e1 * e1 + e2 * e2
+        p = (d0 * e0 + d1 * e1 + d2 * e2) / ln2
+        q0, q1, q2 = d0 - p * e0, d1 - p * e1, d2 - p * e2
+        worst = max(worst, (q0 * q0 + q1 * q1 + q2 * q2) / ln2)
+    return np.sqrt(worst)
+
+
+@njit(cache=True)
+def remove_rigid_motion(x, dx, m):  # pragma: no cover - compiled
+    """Subtract from ``dx`` its M-orthogonal projection on rigid motions (in place).
+
+    Translation and rotation about the ``m``-weighted centroid are ``m``-orthogonal, so the
+    projection is a translation plus ``omega x r`` with ``I omega = sum m r x dx``.
+    """
+    n = x.shape[0]
+    mt = 0.0
+    c = np.zeros(3)
+    t = np.zeros(3)
+    for i in range(n):
+        mt += m[i]
+        for k in range(3):
+            c[k] += m[i] * x[i, k]
+            t[k] += m[i] * dx[i, k]
+    for k in range(3):
+        c[k] /= mt
+        t[k] /= mt
+    inertia = np.zeros((3, 3))
+    torque = np.zeros(3)
+    for i in range(n):
+        r0, r1, r2 = x[i, 0] - c[0], x[i, 1] - c[1], x[i, 2] - c[2]
+        v0, v1, v2 = dx[i, 0] - t[0], dx[i, 1] - t[1], dx[i, 2] - t[2]
+        rr = r0 * r0 + r1 * r1 + r2 * r2
+        r = (r0, r1, r2)
+        for a in range(3):
+            inertia[a, a] += m[i] * rr
+            for b in range(3):
+                inertia[a, b] -= m[i] * r[a] * r[b]
+        torque[0] += m[i] * (r1 * v2 - r2 * v1)
+        torque[1] += m[i] * (r2 * v0 - r0 * v2)
+        torque[2] += m[i] * (r0 * v1 - r1 * v0)
+    omega = np.linalg.lstsq(inertia, torque)[0]
+    for i in range(n):
+        r0, r1, r2 = x[i, 0] - c[0], x[i, 1] - c[1], x[i, 2] - c[2]
+        dx[i, 0] -= t[0] + omega[1] * r2 - omega[2] * r1
+        dx[i, 1] -= t[1] + omega[2] * r0 - omega[0] * r2
+        dx[i, 2] -= t[2] + omega[0] * r1 - omega[1] * r0

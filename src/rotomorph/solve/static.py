@@ -95,7 +95,11 @@ def solve_static(
         err.state = final  # type: ignore[attr-defined]
         raise err
     return StaticResult(
-        state=final, status=res.status, iterations=res.iterations,
-        factorizations=res.factorizations, energy=res.energy, residual=res.residual,
+        state=final,
+        status=res.status,
+        iterations=res.iterations,
+        factorizations=res.factorizations,
+        energy=res.energy,
+        residual=res.residual,
         wall_time=time.perf_counter() - t0,
     )
