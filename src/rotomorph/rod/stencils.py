@@ -30,7 +30,7 @@ class Stencils:
     Attributes
     ----------
     nodes
-        ``(S, 3)`` node indices ``[x0, x1, x2]``: far end of ``e``, the shared node, far end of ``f``.
+        ``(S, 3)`` node indices ``[x0, x1, x2]``: far end of ``e``, shared node, far end of ``f``.
     edge_e, edge_f
         ``(S,)`` indices of the incoming and outgoing edges.
     sign_e, sign_f

@@ -33,9 +33,13 @@ class Objective(Protocol):
     """What :func:`minimize` needs from a problem."""
 
     def evaluate(
-        self, x: FloatArray, need_grad: bool, need_hess: bool
+        self, x: FloatArray, need_grad: bool, need_hess: int
     ) -> tuple[float, FloatArray | None, Any]:
-        """Energy, gradient (or None) and Hessian (or None) at ``x`` relative to the base."""
+        """Energy, gradient (or None) and Hessian (or None) at ``x`` relative to the base.
+
+        ``need_hess``: 0 none, 1 exact, 2 the convex approximation of ``convex_hessian`` (an
+        objective without one returns the exact Hessian for any non-zero value).
+        """
 
     def metric(self) -> FloatArray:
         """Positive diagonal metric ``M`` for the modified-Newton shift."""
@@ -104,20 +108,23 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     f, g, H = obj.evaluate(x, True, True)
     M = obj.metric()
     w = obj.weights()
-    fscale = max(float(np.linalg.norm(w * g)), obj.force_scale, 1e-300)
+    fscale = max(float(_norm(w * g)), obj.force_scale, 1e-300)
     escale = max(obj.energy_scale, abs(f), 1e-300)
     diag = diagonal(H)
     tau_unit = max(float(np.max(np.abs(diag) / M)) if diag.size else 1.0, 1e-300)
     tau_min = 1e-14 * tau_unit
     tau = 0.0
     first_try_ok = True
+    convex = hasattr(obj, "convex_hessian")
+    skip_exact = 0
+    backoff = 0
     history: list[tuple[float, float, float, float]] = []
     n_fact = 0
     dec = np.inf
     status = Status.MAX_ITERATIONS
     it = 0
     while it < opt.max_iterations:
-        res = float(np.linalg.norm(w * g)) / fscale
+        res = float(_norm(w * g)) / fscale
         if not np.isfinite(f) or not np.isfinite(res):
             status = Status.NOT_FINITE
             break
@@ -125,17 +132,29 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             status = Status.CONVERGED
             break
         it += 1
-        # 1) Newton with the exact Hessian (a tiny shift covers free rigid-body modes)
-        pure = True
-        n_fact += 1
-        fac = factorize(H, tau_min * M)
-        d = None if fac is None else fac.solve(-g)
-        if d is None or not np.all(np.isfinite(d)):
-            pure = False
+        # 1) Newton with the exact Hessian (a tiny shift covers free rigid-body modes); after
+        #    the exact Hessian was found indefinite, it is retried only after 1, 2, 4, ...
+        #    iterations (backoff), so an indefinite phase costs no failed factorizations
+        pure = skip_exact == 0
+        if pure:
+            n_fact += 1
+            fac = factorize(H, tau_min * M)
+            d = None if fac is None else fac.solve(-g)
+            if d is None or not np.all(np.isfinite(d)):
+                pure, d = False, None
+                backoff = min(2 * backoff, 8) if backoff else 1
+                skip_exact = backoff
+            else:
+                backoff = 0
+            Hc = obj.convex_hessian(x) if (d is None and convex) else H
+        else:
+            d = None
+            skip_exact -= 1
+            Hc = H  # evaluated in convex mode (see the end of the loop)
+        if d is None:
             # 2) indefinite: the objective's convex (Gauss–Newton) Hessian if it has one,
             #    else the exact one; then the smallest uniform shift that makes it positive
             #    definite, warm-started and relaxed only after a first try succeeded
-            Hc = obj.convex_hessian(x) if hasattr(obj, "convex_hessian") else H
             if first_try_ok:
                 tau = tau_min if tau <= 1e3 * tau_min else tau / 10.0
             tau = max(tau, tau_min)
@@ -151,19 +170,19 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 if tau > 1e12 * tau_unit:
                     status = Status.NOT_FINITE
                     return _result(x, status, it, n_fact, f, res, dec, history)
-            if Hc is H and tau > opt.curvature_shift * tau_unit:
+            if not convex and tau > opt.curvature_shift * tau_unit:
                 v = _negative_curvature_direction(fac, H, M, g, tau, opt.curvature_iterations)
                 if v is not None:
                     d = d + _scale_curvature_step(obj, x, v, d, M)
         if hasattr(obj, "project"):
             d = obj.project(d)
-        slope = float(g @ d)
+        slope = _dot(g, d)
         dec = -0.5 * slope / escale
         if pure and dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
             x = obj.retract(x, d, min(1.0, obj.max_step(x, d)) if hasattr(obj, "max_step") else 1.0)
             obj.accept(x)
             f, g, H = obj.evaluate(x, True, True)
-            res = float(np.linalg.norm(w * g)) / fscale
+            res = float(_norm(w * g)) / fscale
             history.append((f, res, 1.0, tau))
             status = Status.CONVERGED
             return _result(x, status, it, n_fact, f, res, dec, history)
@@ -183,20 +202,32 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             if tau < 1e10 * tau_unit:
                 tau = max(100.0 * tau, 1e-6 * tau_unit)
                 first_try_ok = False
-                H = obj.convex_hessian(x) if hasattr(obj, "convex_hessian") else H
+                if convex and skip_exact == 0:
+                    skip_exact = 1
+                    H = obj.convex_hessian(x)
                 history.append((f, res, 0.0, tau))
                 continue
             status = Status.LINE_SEARCH_FAILED
             break
         x = xt
         obj.accept(x)
-        f, g, H = obj.evaluate(x, True, True)
-        history.append((f, float(np.linalg.norm(w * g)) / fscale, alpha, tau))
+        # exact Hessian (mode 1) unless the backoff asks for the convex one next (mode 2)
+        f, g, H = obj.evaluate(x, True, 1 if (skip_exact == 0 or not convex) else 2)
+        history.append((f, float(_norm(w * g)) / fscale, alpha, tau))
         log.debug(
             "newton %d: E=%.6e res=%.3e alpha=%.3g tau=%.3g", it, f, history[-1][1], alpha, tau
         )
-    res = float(np.linalg.norm(w * g)) / fscale
+    res = float(_norm(w * g)) / fscale
     return _result(x, status, it, n_fact, f, res, dec, history)
+
+
+def _dot(a: FloatArray, b: FloatArray) -> float:
+    """Inner product without BLAS (whose thread start-up dominates at these sizes)."""
+    return float(np.einsum("i,i->", a, b))
+
+
+def _norm(a: FloatArray) -> float:
+    return float(np.sqrt(_dot(a, a)))
 
 
 def _negative_curvature_direction(fac, H, M, g, tau, iterations):  # type: ignore[no-untyped-def]
@@ -215,19 +246,19 @@ def _negative_curvature_direction(fac, H, M, g, tau, iterations):  # type: ignor
     v = np.cos(np.arange(n) * 2.399963229728653)  # deterministic, broadband start
     for _ in range(iterations):
         v = fac.solve(M * v)
-        nv = np.sqrt(float(v @ (M * v)))
+        nv = np.sqrt(_dot(v, M * v))
         if not np.isfinite(nv) or nv == 0:
             return None
         v /= nv
-    lam = float(v @ matvec(H, v))
+    lam = _dot(v, matvec(H, v))
     if not lam < -0.1 * tau:
         return None
-    return -v if float(g @ v) > 0 else v
+    return -v if _dot(g, v) > 0 else v
 
 
 def _scale_curvature_step(obj, x, v, d, M):  # type: ignore[no-untyped-def]
     """Scale ``v`` to the larger of the step's M-norm and a physical move (objective-defined)."""
-    scale = np.sqrt(float(d @ (M * d)))
+    scale = np.sqrt(_dot(d, M * d))
     if hasattr(obj, "curvature_step_scale"):
         scale = max(scale, obj.curvature_step_scale(x, v))
     return scale * v

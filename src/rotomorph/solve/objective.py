@@ -137,14 +137,14 @@ class RodObjective:
     def _setup_matrix(self) -> None:
         red = self._reduced
         rs, re_ = red[self._st_dofs], red[self._ed_dofs]
-        spans = [
-            np.max(
-                np.abs(r[:, :, None] - r[:, None, :])
-                * ((r[:, :, None] >= 0) & (r[:, None, :] >= 0))
-            )
-            for r in (rs, re_)
-            if r.size
-        ]
+        spans = []
+        for r in (rs, re_):
+            if r.size:
+                big = np.iinfo(np.int64).max
+                hi = np.max(np.where(r >= 0, r, -1), axis=1)
+                lo = np.min(np.where(r >= 0, r, big), axis=1)
+                ok = hi >= 0
+                spans.append(int(np.max(hi[ok] - lo[ok])) if ok.any() else 0)
         self.bandwidth = int(max(spans)) if spans else 0
         nfree = len(self.free)
         self.banded = self.bandwidth <= BANDED_LIMIT
@@ -259,17 +259,18 @@ class RodObjective:
             self.set_base(self.state(q))
 
     # ------------------------------------------------------------------ objective
-    def evaluate(self, q: FloatArray, need_grad: bool, need_hess: bool):  # type: ignore[no-untyped-def]
-        """Total potential energy (N mm), gradient and Hessian of the free DOFs."""
+    def evaluate(self, q: FloatArray, need_grad: bool, need_hess: int):  # type: ignore[no-untyped-def]
+        """Total potential energy (N mm), gradient and Hessian of the free DOFs.
+
+        ``need_hess``: 0 none, 1 exact Hessian, 2 Gauss–Newton Hessian (positive semidefinite).
+        """
         u = self._u_base.copy()
         u[self.free] = q
         pos = u[self._pos_index].reshape(-1, 3)
         theta = u[self._theta_index]
         self._last = (q, pos, theta)
-        base = self.base
-        lay = self.model.layout
         try:
-            energy = self._evaluate_network(pos, theta, need_grad, need_hess)
+            energy = self._evaluate_network(pos, theta, need_grad, int(need_hess))
         except ZeroDivisionError:
             if need_grad or need_hess:
                 raise
@@ -345,7 +346,7 @@ class RodObjective:
                 grad[lay.pos[a] + np.arange(3)] -= ge
                 grad[lay.pos[b] + np.arange(3)] += ge
                 grad[lay.theta[j]] -= mt
-            if need_hess:
+            if need_hess == 1:  # the Gauss–Newton mode leaves this indefinite term out
                 h = (np.outer(t, P @ cvec) + np.outer(P @ cvec, t) + (cvec @ t) * P) / ln**2
                 blk = np.block([[h, -h], [-h, h]])
                 self._ed_hess[j] += blk

@@ -14,8 +14,6 @@ Armijo test are unchanged (a retraction in the sense of Absil, Mahony & Sepulchr
 
 from __future__ import annotations
 
-from collections import deque
-
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -135,28 +133,46 @@ class EdgeRotationRetraction:
 
 def _bfs_tree(edges: IntArray, n: int, root: int):  # type: ignore[no-untyped-def]
     """Breadth-first order, parents, parent edges and signs; None if not connected."""
-    adj: list[list[tuple[int, int, float]]] = [[] for _ in range(n)]
-    for j, (a, b) in enumerate(edges):
-        adj[a].append((b, j, 1.0))
-        adj[b].append((a, j, -1.0))
+    e = len(edges)
+    ends = np.concatenate([edges[:, 0], edges[:, 1]])
+    other = np.concatenate([edges[:, 1], edges[:, 0]])
+    sign = np.concatenate([np.ones(e), -np.ones(e)])
+    eid = np.concatenate([np.arange(e), np.arange(e)])
+    order = np.argsort(ends, kind="stable")
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(ends, minlength=n))])
+    out = _bfs(indptr, other[order], eid[order], sign[order], n, root)
+    if out[0].shape[0] != n - 1:
+        return None
+    return out
+
+
+@njit(cache=True)
+def _bfs(indptr, nbr, eid, sgn, n, root):  # pragma: no cover - compiled
     parent = -np.ones(n, dtype=np.int64)
     parent_edge = -np.ones(n, dtype=np.int64)
     sign = np.zeros(n)
-    seen = np.zeros(n, dtype=bool)
+    seen = np.zeros(n, dtype=np.bool_)
+    order = np.empty(n - 1 if n > 0 else 0, dtype=np.int64)
+    queue = np.empty(n, dtype=np.int64)
+    queue[0] = root
     seen[root] = True
-    order: list[int] = []
-    queue = deque([root])
-    while queue:
-        p = queue.popleft()
-        for c, j, s in adj[p]:
+    head, tail, count = 0, 1, 0
+    while head < tail:
+        p = queue[head]
+        head += 1
+        for k in range(indptr[p], indptr[p + 1]):
+            c = nbr[k]
             if not seen[c]:
                 seen[c] = True
-                parent[c], parent_edge[c], sign[c] = p, j, s
-                order.append(c)
-                queue.append(c)
-    if not seen.all():
-        return None
-    return np.array(order, dtype=np.int64), parent, parent_edge, sign
+                parent[c] = p
+                parent_edge[c] = eid[k]
+                sign[c] = sgn[k]
+                if count < order.shape[0]:
+                    order[count] = c
+                count += 1
+                queue[tail] = c
+                tail += 1
+    return order[: min(count, order.shape[0])], parent, parent_edge, sign
 
 
 @njit(cache=True)
