@@ -132,7 +132,7 @@ def test_free_body_under_net_load_is_refused():
     model = helix_model(11)
     with pytest.raises(InvalidParameterError, match="Supports"):
         solve_static(model, loads=Loads(gravity=Gravity(density=1.1, area=0.28)))
-    with pytest.raises(InvalidParameterError, match="Loads.forces"):
+    with pytest.raises(InvalidParameterError, match=r"Loads\.forces"):
         solve_static(model, Supports(pinned_nodes=[0]), Loads(forces=[(99, (0, 0, 1))]))
 
 
