@@ -10,7 +10,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1] / "src" / "rotomorph"
 LAYERS = [
-    {"", "errors", "_typing", "geometry"},
+    {"", "__init__", "errors", "_typing", "geometry"},
     {"design"},
     {"materials"},
     {"rod"},
