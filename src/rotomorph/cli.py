@@ -1,0 +1,365 @@
+"""The ``rotomorph`` command line: one thin command per public function.
+
+Commands::
+
+    rotomorph validate DESIGN.toml            check a design file (or --schema: print the schema)
+    rotomorph gcode DESIGN.toml -o FILE --dialect aerotech|rs274|marlin [--machine PROFILE.toml]
+    rotomorph simulate DESIGN.toml -o OUT/    predicted shapes over heating (HDF5, figures, …)
+    rotomorph plot RESULT.h5 -o DIR           figures and GIF from a results file
+    rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
+
+Exit codes: 0 success; 1 the computation failed (solver did not converge, machine limits);
+2 bad input (command line, design file, missing file, existing output folder).
+Errors print one line on stderr: ``rotomorph: error: <field>: <what is wrong and the fix>``.
+
+Folders (``simulate``, ``plot``, ``paper``) are written into a temporary sibling folder and
+renamed at the end, so a failed run leaves no partial output behind.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import logging
+import os
+import shutil
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import rotomorph
+from rotomorph.errors import (
+    ConvergenceError,
+    GcodeParseError,
+    InvalidParameterError,
+    MachineLimitError,
+    RotomorphError,
+)
+
+__all__ = ["EXIT_FAILED", "EXIT_OK", "EXIT_USAGE", "entry_point", "main"]
+
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_USAGE = 2
+DIALECTS = ("aerotech", "rs274", "marlin")
+
+
+class UsageError(Exception):
+    """Bad input the user can fix (exit code 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises instead of exiting, so ``main`` returns the code."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise UsageError(f"{self.prog}: {message} (see --help)")
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _progress(total: int, desc: str) -> Any:
+    """A tqdm bar on stderr, silent when stderr is not a terminal."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit="step", disable=not sys.stderr.isatty(), leave=False)
+
+
+def _existing_file(path: str, what: str) -> Path:
+    if not path:
+        raise UsageError(f"{what}: empty path; give a file name")
+    p = Path(path)
+    if not p.exists():
+        raise UsageError(f"{what}: {path}: no such file")
+    if p.is_dir():
+        raise UsageError(f"{what}: {path}: is a folder, expected a file")
+    return p
+
+
+def _load_design(path: str) -> Any:
+    from rotomorph.io.designfile import load_design
+
+    return load_design(_existing_file(path, "DESIGN"))
+
+
+@contextlib.contextmanager
+def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
+    """Yield a temporary folder next to ``path``; rename it onto ``path`` on success.
+
+    On error the temporary folder is removed and ``path`` is untouched.
+    """
+    if not path:
+        raise UsageError("-o/--output: empty path; give a folder name")
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise UsageError(f"-o/--output: {path}: exists and is not a folder")
+    if target.is_dir() and any(target.iterdir()) and not force:
+        raise UsageError(f"-o/--output: {path}: folder is not empty; use --force to replace it")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"-o/--output: {parent}: parent folder does not exist")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=parent))
+    try:
+        yield tmp
+        os.chmod(tmp, 0o777 & ~_umask())
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=parent))
+            os.replace(target, old / "x")
+            os.replace(tmp, target)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _print(text: str) -> None:
+    sys.stdout.write(text + "\n")
+
+
+# ----------------------------------------------------------------------------- commands
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from rotomorph.io.designfile import design_schema
+
+    if args.schema:
+        _print(json.dumps(design_schema(), indent=2))
+        if args.design is None:
+            return EXIT_OK
+    if args.design is None:
+        raise UsageError("validate: give DESIGN.toml (or --schema)")
+    design = _load_design(args.design)
+    programs = design.to_programs()
+    parts = []
+    if design.filaments:
+        parts.append(f"{len(design.filaments)} filament(s)")
+    if design.lattice is not None:
+        lat = design.lattice
+        parts.append(f"lattice {lat.n}x{lat.n} '{lat.pattern}' in {lat.layers} layer(s)")
+    length = sum(float(p.arc_length[-1]) for p in programs)
+    _print(
+        f"{args.design}: valid design '{design.name}': {', '.join(parts)}; "
+        f"{len(programs)} print program(s), {length:.1f} mm of filament; "
+        f"sha256 {design.sha256()[:12]}"
+    )
+    return EXIT_OK
+
+
+def _cmd_gcode(args: argparse.Namespace) -> int:
+    from rotomorph.io.gcode import write_gcode
+    from rotomorph.io.machine import MachineProfile, load_machine_profile
+
+    design = _load_design(args.design)
+    if not args.output:
+        raise UsageError("-o/--output: empty path; give a file name")
+    out = Path(args.output)
+    if out.is_dir():
+        raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise UsageError(f"-o/--output: {out.parent}: folder does not exist")
+    if args.machine is not None:
+        machine = load_machine_profile(_existing_file(args.machine, "--machine"))
+        if args.dialect is not None and args.dialect != machine.dialect:
+            from dataclasses import replace
+
+            machine = replace(machine, dialect=args.dialect)
+    else:
+        machine = MachineProfile(dialect=args.dialect or "aerotech")
+    programs = design.to_programs()
+    write_gcode(programs, out, machine, **design.gcode_options(), layer_cure_s=args.cure)
+    _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
+    return EXIT_OK
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from rotomorph.simulate.design import simulate_design, step_count
+    from rotomorph.simulate.outputs import write_run
+
+    design = _load_design(args.design)
+    if args.steps < 1:
+        raise UsageError(f"--steps: must be >= 1; got {args.steps}")
+    if args.spacing is not None and not args.spacing > 0:
+        raise UsageError(f"--spacing: must be > 0 mm; got {args.spacing}")
+    with _output_folder(args.output, force=args.force) as tmp:
+        with _progress(step_count(design, args.steps), "simulate") as bar:
+            sim = simulate_design(
+                design,
+                steps=args.steps,
+                start_temperature=args.start_temperature,
+                temperature=args.temperature,
+                spacing=args.spacing,
+                actuation=args.actuation,
+                progress=bar.update,
+            )
+        write_run(sim, tmp, gif=not args.no_gif)
+    final = sim.metadata.get("final") or {}
+    if sim.kind == "filaments":
+        desc = ", ".join(
+            f"{f['name']}: L/L0 = {f['end_to_end_ratio']:.3f} ({f['morphology']})"
+            for f in sim.metadata["filaments"]
+        )
+    else:
+        desc = (
+            f"area ratio {final.get('area_ratio', float('nan')):.3f}, "
+            f"Gaussian sign {final.get('gaussian_sign', float('nan')):+.0f}"
+        )
+    _print(f"wrote {args.output}: {desc}")
+    return EXIT_OK
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from rotomorph.io.results import read_results
+    from rotomorph.simulate.outputs import plot_run
+
+    path = _existing_file(args.result, "RESULT")
+    try:
+        results = read_results(path)
+    except OSError as err:
+        raise UsageError(f"RESULT: {args.result}: not an HDF5 results file ({err})") from None
+    with _output_folder(args.output, force=args.force) as tmp:
+        paths = plot_run(results, tmp, gif=not args.no_gif)
+    _print(f"wrote {len(paths)} file(s) to {args.output}")
+    return EXIT_OK
+
+
+def _cmd_paper(args: argparse.Namespace) -> int:
+    from rotomorph.simulate.report import paper_report
+
+    with _output_folder(args.output, force=args.force) as tmp:
+        with _progress(0, "paper") as bar:
+
+            def progress(done: int, total: int) -> None:
+                bar.total = total
+                bar.update(done)
+
+            report = paper_report(tmp, quick=args.quick, progress=progress)
+    _print(
+        f"wrote {args.output}/report.md and summary.json: {len(report.rows)} rows "
+        f"in {report.wall_time:.0f} s"
+    )
+    return EXIT_OK
+
+
+# ----------------------------------------------------------------------------- parser
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``rotomorph`` (every command has ``--help``)."""
+    parser = _Parser(
+        prog="rotomorph",
+        description="Design, simulate and print shape-morphing active-passive filaments.",
+        epilog="Exit codes: 0 ok, 1 computation failed, 2 bad input.",
+    )
+    parser.add_argument("--version", action="version", version=rotomorph.__version__)
+    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("validate", help="check a design file", description="Check a design file.")
+    p.add_argument("design", nargs="?", metavar="DESIGN.toml")
+    p.add_argument("--schema", action="store_true", help="print the design file's JSON Schema")
+    p.set_defaults(func=_cmd_validate)
+
+    p = sub.add_parser("gcode", help="write G-code for a design", description="Write G-code.")
+    p.add_argument("design", metavar="DESIGN.toml")
+    p.add_argument("-o", "--output", required=True, metavar="FILE", help="G-code file to write")
+    p.add_argument("--dialect", choices=DIALECTS, help="default: the machine's, else aerotech")
+    p.add_argument("--machine", metavar="PROFILE.toml", help="machine profile (limits, axes)")
+    p.add_argument("--cure", type=float, default=0.0, metavar="S", help="UV dwell per layer (s)")
+    p.set_defaults(func=_cmd_gcode)
+
+    p = sub.add_parser(
+        "simulate",
+        help="predict shapes over heating",
+        description="Predicted shapes over heating: results.h5, summary.json, figures/, "
+        "morphing.gif and a ParaView series in paraview/.",
+    )
+    p.add_argument("design", metavar="DESIGN.toml")
+    p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
+    p.add_argument("--steps", type=int, default=8, help="heating steps (default 8)")
+    p.add_argument("--temperature", type=float, default=175.0, help="final temperature (°C)")
+    p.add_argument("--start-temperature", type=float, default=25.0, help="print temperature (°C)")
+    p.add_argument("--spacing", type=float, help="filament vertex spacing override (mm)")
+    p.add_argument(
+        "--actuation",
+        default="swapped",
+        choices=("literal", "swapped", "radius", "additive", "thermal"),
+        help="lattice actuation rule (default swapped; see rotomorph.lattice.actuation)",
+    )
+    p.add_argument("--no-gif", action="store_true", help="skip the GIF")
+    p.add_argument("--force", action="store_true", help="replace a non-empty OUT")
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser(
+        "plot", help="figures from a results file", description="Figures and GIF from RESULT.h5."
+    )
+    p.add_argument("result", metavar="RESULT.h5")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write")
+    p.add_argument("--no-gif", action="store_true", help="skip the GIF")
+    p.add_argument("--force", action="store_true", help="replace a non-empty DIR")
+    p.set_defaults(func=_cmd_plot)
+
+    p = sub.add_parser(
+        "paper",
+        help="reproduce the paper's computational figures",
+        description="Reproduce the paper's computational figures and write OUT/report.md "
+        "and OUT/summary.json (measured vs predicted).",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
+    p.add_argument("--quick", action="store_true", help="coarse and fast (for tests)")
+    p.add_argument("--force", action="store_true", help="replace a non-empty OUT")
+    p.set_defaults(func=_cmd_paper)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``rotomorph`` with ``argv`` (default ``sys.argv[1:]``) and return the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(None if argv is None else list(argv))
+        if args.command is None:
+            parser.print_help(sys.stderr)
+            return EXIT_USAGE
+        logging.basicConfig(
+            level=logging.INFO if args.verbose else logging.WARNING,
+            format="rotomorph: %(levelname)s: %(message)s",
+        )
+        return int(args.func(args))
+    except SystemExit as exc:  # --help, --version
+        return int(exc.code or 0) if isinstance(exc.code, int) else EXIT_OK
+    except UsageError as err:
+        return _fail(str(err), EXIT_USAGE)
+    except (InvalidParameterError, GcodeParseError) as err:
+        return _fail(str(err), EXIT_USAGE)
+    except ConvergenceError as err:
+        return _fail(f"solver: {err}", EXIT_FAILED)
+    except MachineLimitError as err:
+        return _fail(f"machine limits: {err}", EXIT_FAILED)
+    except RotomorphError as err:
+        return _fail(str(err), EXIT_FAILED)
+    except OSError as err:
+        name = f"{err.filename}: " if err.filename else ""
+        return _fail(f"{name}{err.strerror or err}", EXIT_USAGE)
+    except KeyboardInterrupt:
+        return _fail("interrupted", 130)
+
+
+def _fail(message: str, code: int) -> int:
+    line = " ".join(message.split())
+    sys.stderr.write(f"rotomorph: error: {line}\n")
+    return code
+
+
+def entry_point() -> None:
+    """Console-script entry point (``rotomorph``)."""
+    raise SystemExit(main())

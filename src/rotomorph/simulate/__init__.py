@@ -1,0 +1,1 @@
+"""Simulation drivers: filaments over a heating ramp, lattice designs, and the paper report."""

@@ -1,0 +1,309 @@
+"""Simulate a whole design file: its filaments (rod solver per filament) or its lattice.
+
+:func:`simulate_design` returns a :class:`DesignSimulation` holding everything one results file
+stores (:func:`rotomorph.io.results.write_results`): positions per step, topology, per-step
+scalars and fields with units, and metadata. Several filaments share one network of disjoint
+chains (node offsets in ``metadata["chains"]``); they are solved independently.
+
+Lattices go through :func:`rotomorph.lattice.heating.heat_lattice` (imported when needed).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+import rotomorph
+from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.analysis.curvature import network_relative_curvature_change
+from rotomorph.errors import InvalidDesignError
+from rotomorph.io.results import RunResults, to_jsonable
+from rotomorph.materials.natural import FilamentModel
+from rotomorph.simulate.filament import (
+    ACTUATION_TEMPERATURE,
+    PRINT_TEMPERATURE,
+    FilamentSimulation,
+    simulate_filament,
+)
+
+__all__ = ["DesignSimulation", "simulate_design", "step_count"]
+
+Progress = Callable[[int], None]
+
+
+@dataclass(frozen=True, eq=False)
+class DesignSimulation:
+    """Shapes of a design over heating, in the layout of a results file.
+
+    Attributes
+    ----------
+    kind
+        ``"filaments"`` or ``"lattice"``.
+    design
+        The resolved design (JSON-compatible).
+    edges, branch
+        Topology ``(E, 2)`` and branch flags ``(N,)``.
+    positions
+        ``(S, N, 3)`` node positions per step (mm).
+    scalars, fields, units
+        Per-step scalars ``(S,)`` and arrays ``(S, ...)`` by name, and their units.
+    metadata
+        Run information (version, timings, per-filament or lattice results).
+    filaments
+        Per-filament results (``kind == "filaments"``).
+    lattice
+        The lattice heating result (``kind == "lattice"``).
+    """
+
+    kind: str
+    design: Mapping[str, Any]
+    edges: IntArray
+    branch: BoolArray
+    positions: FloatArray
+    scalars: Mapping[str, FloatArray]
+    fields: Mapping[str, FloatArray] = field(default_factory=dict)
+    units: Mapping[str, str] = field(default_factory=dict)
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    filaments: tuple[FilamentSimulation, ...] = ()
+    lattice: Any = None
+
+    def run_results(self) -> RunResults:
+        """The same data as :class:`~rotomorph.io.results.RunResults` (what the file holds)."""
+        return RunResults(
+            design=self.design,
+            edges=self.edges,
+            branch=self.branch,
+            positions=self.positions,
+            scalars=dict(self.scalars),
+            fields=dict(self.fields),
+            units={"positions": "mm", **self.units},
+            metadata=to_jsonable(dict(self.metadata)),
+        )
+
+
+def step_count(design: Any, steps: int) -> int:
+    """Progress units :func:`simulate_design` reports for ``design`` (for a progress bar)."""
+    if design.lattice is not None:
+        return 1
+    return len(design.filaments) * (steps + 1)
+
+
+def _filament_summary(sim: FilamentSimulation) -> dict[str, Any]:
+    out: dict[str, Any] = {
+        "name": sim.name,
+        "end_to_end_ratio": sim.final_ratio,
+        "morphology": sim.morphology.value,
+        "iterations": int(sim.iterations.sum()),
+        "wall_time_s": round(sim.wall_time, 3),
+    }
+    if sim.helix is not None:
+        out["helix"] = {
+            "radius_mm": sim.helix.radius,
+            "pitch_mm": sim.helix.pitch,
+            "handedness": sim.helix.handedness,
+            "turns": sim.helix.turns,
+            "rms_residual_mm": sim.helix.rms_residual,
+        }
+    if sim.closed_form is not None:
+        out["closed_form_end_to_end_ratio"] = float(sim.closed_form.end_to_end_ratio)
+        out["closed_form_shape"] = str(sim.closed_form.label)
+    return out
+
+
+def _simulate_filaments(
+    design: Any,
+    *,
+    steps: int,
+    start_temperature: float,
+    temperature: float,
+    model: FilamentModel | None,
+    spacing: float | None,
+    progress: Progress | None,
+) -> DesignSimulation:
+    sims = []
+    for i, fil in enumerate(design.filaments):
+        if spacing is not None:
+            fil = fil.model_copy(update={"spacing": spacing})
+        program = fil.to_program()
+        sims.append(
+            simulate_filament(
+                program,
+                name=fil.name or f"filament {i}",
+                steps=steps,
+                start_temperature=start_temperature,
+                temperature=temperature,
+                model=model,
+                progress=progress,
+            )
+        )
+    sizes = [len(s.printed) for s in sims]
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    edges = np.concatenate(
+        [
+            np.stack([np.arange(n - 1), np.arange(1, n)], axis=1) + o
+            for n, o in zip(sizes, offsets, strict=False)
+        ]
+    )
+    first = sims[0]
+    scalars = {
+        "temperature": first.temperature,
+        "actuation": first.actuation,
+        "energy": np.sum([s.energy for s in sims], axis=0),
+        "iterations": np.sum([s.iterations for s in sims], axis=0),
+        "residual": np.max([s.residual for s in sims], axis=0),
+        "end_to_end_ratio": np.mean([s.end_to_end_ratio for s in sims], axis=0),
+    }
+    fields = {
+        "end_to_end_ratio_per_filament": np.stack([s.end_to_end_ratio for s in sims], axis=1),
+        "curvature": np.concatenate([s.curvature for s in sims], axis=1),
+    }
+    metadata = {
+        "kind": "filaments",
+        "chains": [
+            {"name": s.name, "start": int(o), "stop": int(o + n)}
+            for s, o, n in zip(sims, offsets, sizes, strict=False)
+        ],
+        "filaments": [_filament_summary(s) for s in sims],
+        "temperature_range_degC": [start_temperature, temperature],
+        "steps": steps,
+    }
+    return DesignSimulation(
+        kind="filaments",
+        design=design.model_dump(mode="json"),
+        edges=edges.astype(np.int64),
+        branch=np.zeros(int(offsets[-1]), dtype=bool),
+        positions=np.concatenate([s.positions for s in sims], axis=1),
+        scalars=scalars,
+        fields=fields,
+        units={
+            "end_to_end_ratio_per_filament": "1",
+            "curvature": "1/mm",
+        },
+        metadata=metadata,
+        filaments=tuple(sims),
+    )
+
+
+def _simulate_lattice(
+    design: Any, *, steps: int, actuation: str, progress: Progress | None
+) -> DesignSimulation:
+    from rotomorph.lattice.heating import heat_lattice  # lattice-only
+
+    lattice = design.lattice.to_lattice()
+    res = heat_lattice(lattice, actuation=actuation, steps=steps)
+    if progress is not None:
+        progress(1)
+    pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
+    rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])
+    ramp = "temperature" if actuation == "thermal" else "actuation"
+    scalars = {
+        ramp: np.asarray(res.parameter, dtype=float),
+        "energy": np.asarray(res.energy, dtype=float),
+        "iterations": np.asarray(res.iterations, dtype=float),
+        "residual": np.asarray(res.residual, dtype=float),
+        "area_ratio": np.asarray(res.area_ratio, dtype=float),
+        "gaussian_sign": np.asarray(res.gaussian_sign, dtype=float),
+        "characteristic_curvature": np.asarray(res.characteristic_curvature, dtype=float),
+        "edge_strain": np.asarray(res.mean_edge_strain, dtype=float),
+        "min_clearance": np.asarray(res.min_clearance, dtype=float),
+    }
+    fields = {
+        "relative_curvature_change": rel,
+        "edge_end_to_end_ratio": np.asarray(res.edge_ratios, dtype=float),
+    }
+    metadata = {
+        "kind": "lattice",
+        "pattern": design.lattice.pattern,
+        "n": design.lattice.n,
+        "steps": steps,
+        "edge_mode": list(lattice.edge_mode),
+        "final": {k: float(v[-1]) for k, v in scalars.items()},
+        "actuation_rule": res.actuation,
+        "lattice_wall_time_s": float(np.sum(res.wall_time)),
+    }
+    net = lattice.network
+    return DesignSimulation(
+        kind="lattice",
+        design=design.model_dump(mode="json"),
+        edges=np.asarray(net.edges, dtype=np.int64),
+        branch=np.asarray(net.branch, dtype=bool),
+        positions=pos,
+        scalars=scalars,
+        fields=fields,
+        units={
+            "relative_curvature_change": "1",
+            "edge_end_to_end_ratio": "1",
+            "min_clearance": "1",
+        },
+        metadata=metadata,
+        lattice=res,
+    )
+
+
+def simulate_design(
+    design: Any,
+    *,
+    steps: int = 8,
+    start_temperature: float = PRINT_TEMPERATURE,
+    temperature: float = ACTUATION_TEMPERATURE,
+    model: FilamentModel | None = None,
+    spacing: float | None = None,
+    actuation: str = "swapped",
+    progress: Progress | None = None,
+) -> DesignSimulation:
+    """Predicted shapes of a design (:class:`rotomorph.io.designfile.Design`) over heating.
+
+    Parameters
+    ----------
+    design
+        A validated design with filaments or a lattice (not both).
+    steps
+        Heating steps; results hold ``steps + 1`` states.
+    start_temperature, temperature
+        Ramp of the filaments (°C); lattices use their own actuation parameter.
+    model
+        Filament modelling choices (default calibrated :class:`FilamentModel`).
+    spacing
+        Override the filaments' vertex spacing (mm); coarser is faster.
+    actuation
+        Lattice actuation rule (:data:`rotomorph.lattice.actuation.ACTUATIONS`; default
+        ``"swapped"``, notes Q4).
+    progress
+        Called with the number of finished units (see :func:`step_count`).
+
+    Raises
+    ------
+    InvalidDesignError
+        A design with both filaments and a lattice.
+    ConvergenceError
+        A solve failed.
+    """
+    t0 = time.perf_counter()
+    if design.filaments and design.lattice is not None:
+        raise InvalidDesignError(
+            "lattice", "simulate handles filaments or a lattice, not both; split the design file"
+        )
+    if design.lattice is not None:
+        sim = _simulate_lattice(design, steps=steps, actuation=actuation, progress=progress)
+    else:
+        sim = _simulate_filaments(
+            design,
+            steps=steps,
+            start_temperature=start_temperature,
+            temperature=temperature,
+            model=model,
+            spacing=spacing,
+            progress=progress,
+        )
+    meta = dict(sim.metadata)
+    meta.update(
+        rotomorph_version=rotomorph.__version__,
+        design_name=design.name,
+        design_sha256=design.sha256(),
+        wall_time_s=round(time.perf_counter() - t0, 3),
+    )
+    return replace(sim, metadata=meta)

@@ -1,0 +1,339 @@
+"""Simulate one printed filament over a heating ramp with the rod solver.
+
+Pipeline per actuation step (DESIGN.md section 1)::
+
+    PrintProgram ──natural_field(T)──► NaturalField ──Model.chain──► Model ──solve_static──►
+    equilibrium ──analysis──► L/L0, helix fit, morphology
+
+The ramp is uniform in the actuation fraction x (not in temperature): x(T) is a steep sigmoid
+around T_NI, so equal temperature steps would put the whole shape change into one or two steps.
+Each step starts from the previous equilibrium (continuation); a step whose Newton solve fails
+is split in halves (up to ``max_refinements`` times) before the error propagates.
+
+Step 0 is the printed (stress-free) configuration at ``start_temperature``; the tiny actuation
+there (x ≈ 1e-3 at 25 °C) is not solved for, its natural field only starts the ramp.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.analysis.curvature import discrete_curvature
+from rotomorph.analysis.shape import (
+    HelixFit,
+    Morphology,
+    end_to_end_ratio,
+    fit_helix,
+    polyline_morphology,
+)
+from rotomorph.errors import ConvergenceError, InvalidParameterError, RotomorphError
+from rotomorph.materials.material import Material, get_material
+from rotomorph.materials.natural import FilamentModel, NaturalField, natural_field
+from rotomorph.materials.process import actuation_fraction
+from rotomorph.rod.model import Model
+from rotomorph.rod.state import State
+from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.static import StaticResult, solve_static
+
+__all__ = [
+    "FilamentSimulation",
+    "heating_temperatures",
+    "rod_model",
+    "simulate_filament",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Room temperature at which filaments are printed (°C).
+PRINT_TEMPERATURE = 25.0
+#: Actuation temperature of the paper's filaments (°C).
+ACTUATION_TEMPERATURE = 175.0
+
+Progress = Callable[[int], None]
+
+
+@dataclass(frozen=True, eq=False)
+class FilamentSimulation:
+    """A filament's equilibrium shapes over a heating ramp.
+
+    Attributes
+    ----------
+    name
+        Label (the design's filament name).
+    printed
+        Printed vertices ``(N, 3)`` (mm).
+    temperature
+        ``(S,)`` temperatures (°C), step 0 the printed state.
+    actuation
+        ``(S,)`` actuation fraction x (dimensionless).
+    positions
+        ``(S, N, 3)`` equilibrium vertices (mm).
+    end_to_end_ratio
+        ``(S,)`` L/L0: end-to-end distance over the printed one.
+    curvature
+        ``(S, N)`` discrete curvature per vertex (1/mm; NaN at the two ends).
+    energy, iterations, residual
+        ``(S,)`` elastic energy (N mm), Newton iterations (all sub-steps), relative residual.
+    helix
+        Helix fitted to the final shape, or ``None`` (straight, or the fit failed).
+    morphology
+        Label of the final shape (from its median curvature and material twist).
+    closed_form
+        Closed-form free-helix prediction (notes 1.6) for a uniform natural field, else ``None``.
+    wall_time
+        Seconds spent.
+    """
+
+    name: str
+    printed: FloatArray
+    temperature: FloatArray
+    actuation: FloatArray
+    positions: FloatArray
+    end_to_end_ratio: FloatArray
+    curvature: FloatArray
+    energy: FloatArray
+    iterations: FloatArray
+    residual: FloatArray
+    helix: HelixFit | None
+    morphology: Morphology
+    closed_form: Any
+    wall_time: float
+
+    @property
+    def final_ratio(self) -> float:
+        """L/L0 at the last step."""
+        return float(self.end_to_end_ratio[-1])
+
+
+def _active_material(program: Any, materials: Mapping[str, Material] | None) -> Material:
+    name = program.active_material
+    return materials[name] if materials and name in materials else get_material(name)
+
+
+def heating_temperatures(
+    program: Any,
+    steps: int,
+    *,
+    start_temperature: float = PRINT_TEMPERATURE,
+    temperature: float = ACTUATION_TEMPERATURE,
+    materials: Mapping[str, Material] | None = None,
+    model: FilamentModel | None = None,
+) -> FloatArray:
+    """``steps + 1`` temperatures (°C) from ``start_temperature`` whose actuation is uniform in x.
+
+    Parameters
+    ----------
+    program
+        Print program (its ``active_material`` sets T_NI).
+    steps
+        Number of heating steps (≥ 1).
+    start_temperature, temperature
+        First and last temperature (°C), ``start_temperature < temperature``.
+    materials, model
+        As for :func:`~rotomorph.materials.natural_field`.
+    """
+    if steps < 1:
+        raise InvalidParameterError("steps", f"must be >= 1; got {steps}")
+    if not (np.isfinite(start_temperature) and np.isfinite(temperature)):
+        raise InvalidParameterError("temperature", "must be finite (°C)")
+    if not start_temperature < temperature:
+        raise InvalidParameterError(
+            "temperature",
+            f"must exceed the start temperature {start_temperature} °C; got {temperature} °C",
+        )
+    model = FilamentModel() if model is None else model
+    active = _active_material(program, materials)
+    grid = np.linspace(start_temperature, temperature, 2001)
+    x = actuation_fraction(
+        grid,
+        active.transition_temperature,  # type: ignore[arg-type]
+        model.transition_width,
+        direction=model.direction,
+        hysteresis=model.hysteresis,
+    )
+    targets = np.linspace(x[0], x[-1], steps + 1)
+    temps = np.interp(targets, x, grid)
+    temps[0], temps[-1] = start_temperature, temperature
+    return temps
+
+
+def rod_model(program: Any, field: NaturalField) -> Model:
+    """The rod :class:`~rotomorph.rod.model.Model` of a printed filament with natural ``field``."""
+    return Model.chain(
+        np.asarray(program.points, dtype=float),
+        bending_stiffness1=field.bending_stiffness1,
+        bending_stiffness2=field.bending_stiffness2,
+        twist_stiffness=field.twist_stiffness,
+        axial_stiffness=field.axial_stiffness,
+        directors=field.directors,
+        natural_curvature1=field.curvature1,
+        natural_curvature2=field.curvature2,
+        natural_twist=field.twist,
+        rest_length=field.rest_length,
+    )
+
+
+def _blend(a: NaturalField, b: NaturalField, w: float) -> NaturalField:
+    """Field between two temperatures' fields (used only for the halved sub-steps)."""
+
+    def mix(name: str) -> FloatArray:
+        return (1.0 - w) * getattr(a, name) + w * getattr(b, name)
+
+    return NaturalField(
+        directors=b.directors,
+        curvature1=mix("curvature1"),
+        curvature2=mix("curvature2"),
+        twist=mix("twist"),
+        voronoi_length=b.voronoi_length,
+        rest_length=mix("rest_length"),
+        axial_strain=mix("axial_strain"),
+        bending_stiffness1=b.bending_stiffness1,
+        bending_stiffness2=b.bending_stiffness2,
+        twist_stiffness=b.twist_stiffness,
+        axial_stiffness=b.axial_stiffness,
+        actuation=(1.0 - w) * a.actuation + w * b.actuation,
+        measure=b.measure,
+    )
+
+
+def _solve_step(
+    program: Any,
+    previous: NaturalField,
+    target: NaturalField,
+    initial: State,
+    options: NewtonOptions | None,
+    depth: int,
+) -> tuple[StaticResult, int]:
+    """Solve at ``target`` from ``initial``; halve the step on failure. Returns (result, iters)."""
+    try:
+        res = solve_static(rod_model(program, target), initial=initial, options=options)
+        return res, res.iterations
+    except ConvergenceError:
+        if depth <= 0:
+            raise
+        logger.info("step to x=%.4f failed; halving it", target.actuation)
+    mid = _blend(previous, target, 0.5)
+    first, n1 = _solve_step(program, previous, mid, initial, options, depth - 1)
+    second, n2 = _solve_step(program, mid, target, first.state, options, depth - 1)
+    return second, n1 + n2
+
+
+def _final_shape(points: FloatArray, state: State) -> tuple[HelixFit | None, Morphology]:
+    m1, _ = state.material_directors()
+    try:
+        morph = polyline_morphology(points, m1)
+    except RotomorphError:
+        morph = Morphology.STRAIGHT
+    helix = None
+    if morph in (Morphology.HELIX, Morphology.COIL):
+        try:
+            helix = fit_helix(points)
+        except (RotomorphError, ValueError, np.linalg.LinAlgError):
+            helix = None
+    return helix, morph
+
+
+def simulate_filament(
+    program: Any,
+    *,
+    name: str = "",
+    steps: int = 8,
+    start_temperature: float = PRINT_TEMPERATURE,
+    temperature: float = ACTUATION_TEMPERATURE,
+    materials: Mapping[str, Material] | None = None,
+    model: FilamentModel | None = None,
+    options: NewtonOptions | None = None,
+    max_refinements: int = 4,
+    progress: Progress | None = None,
+) -> FilamentSimulation:
+    """Equilibrium shapes of a free filament heated from ``start_temperature`` to ``temperature``.
+
+    Parameters
+    ----------
+    program
+        The filament's :class:`~rotomorph.design.program.PrintProgram`.
+    name
+        Label stored with the result.
+    steps
+        Heating steps (uniform in actuation x); the result has ``steps + 1`` states.
+    start_temperature, temperature
+        Printing and final temperature (°C).
+    materials, model
+        As for :func:`~rotomorph.materials.natural_field`.
+    options
+        Newton settings of each solve.
+    max_refinements
+        Times a failing step may be halved.
+    progress
+        Called with 1 after every step (for a progress bar).
+
+    Raises
+    ------
+    ConvergenceError
+        A step failed even after ``max_refinements`` halvings.
+    InvalidDesignError, MaterialError
+        Malformed program or unknown materials.
+    """
+    t0 = time.perf_counter()
+    temps = heating_temperatures(
+        program,
+        steps,
+        start_temperature=start_temperature,
+        temperature=temperature,
+        materials=materials,
+        model=model,
+    )
+    printed = np.asarray(program.points, dtype=float)
+    fields = [natural_field(program, materials, float(t), model=model) for t in temps]
+    state = rod_model(program, fields[0]).reference_state()
+    s = len(temps)
+    positions = np.empty((s, len(printed), 3))
+    energy, iterations, residual = np.zeros(s), np.zeros(s), np.zeros(s)
+    # step 0 is the printed shape: at x(T0) ~ 1e-3 the loads are so small that a solve only
+    # chases round-off (the residual is relative to the force scale)
+    positions[0] = printed
+    if progress is not None:
+        progress(1)
+    for k in range(1, s):
+        res, its = _solve_step(program, fields[k - 1], fields[k], state, options, max_refinements)
+        state = res.state
+        positions[k], energy[k], iterations[k], residual[k] = (
+            res.positions,
+            res.energy,
+            its,
+            res.residual,
+        )
+        if progress is not None:
+            progress(1)
+    ratio = np.array([end_to_end_ratio(p, printed) for p in positions])
+    curvature = np.full((s, len(printed)), np.nan)
+    for k in range(s):
+        curvature[k, 1:-1] = discrete_curvature(positions[k])
+    helix, morph = _final_shape(positions[-1], state)
+    try:
+        closed = fields[-1].morphology(rtol=1e-6)
+    except RotomorphError:
+        closed = None
+    return FilamentSimulation(
+        name=name,
+        printed=printed,
+        temperature=temps,
+        actuation=np.array([f.actuation for f in fields]),
+        positions=positions,
+        end_to_end_ratio=ratio,
+        curvature=curvature,
+        energy=energy,
+        iterations=iterations,
+        residual=residual,
+        helix=helix,
+        morphology=morph,
+        closed_form=closed,
+        wall_time=time.perf_counter() - t0,
+    )

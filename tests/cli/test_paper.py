@@ -1,0 +1,75 @@
+"""``rotomorph paper --quick``: report, summary rows and figures, read back and re-checked."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from rotomorph.cli import EXIT_OK, main
+from rotomorph.materials import load_table
+from rotomorph.materials.calibrate import janus_curvature
+from rotomorph.simulate.report import calibrated_model
+
+KEYS = {"quantity", "condition", "measured", "spread", "predicted", "error", "calibration", "note"}
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("paper") / "out"
+    assert main(["paper", "-o", str(out), "--quick"]) == EXIT_OK
+    return out
+
+
+@pytest.mark.slow
+def test_summary_rows(report):
+    rows = json.loads((report / "summary.json").read_text())
+    assert isinstance(rows, list) and rows
+    for r in rows:
+        assert KEYS <= set(r), r
+        if r["measured"] is not None and r["predicted"] is not None:
+            assert r["error"] == pytest.approx(r["predicted"] - r["measured"], abs=2e-4)
+    quantities = {r["quantity"] for r in rows}
+    assert {
+        "janus_curvature",
+        "pure_lce_length_L_over_L0",
+        "composite_length_L_over_L0",
+        "sinusoid_end_to_end_ratio",
+        "lattice_area_ratio",
+        "lattice_gaussian_sign",
+    } <= quantities
+
+
+@pytest.mark.slow
+def test_numbers_match_the_models(report):
+    rows = json.loads((report / "summary.json").read_text())
+    model, _ = calibrated_model()
+    table = load_table("janus_curvature")
+    expected = janus_curvature(model, table.x)
+    got = [r for r in rows if r["quantity"] == "janus_curvature"]
+    assert [r["condition"] for r in got] == list(table.condition)
+    np.testing.assert_allclose([r["predicted"] for r in got], expected, atol=1e-4)
+    assert sum(r["calibration"] for r in got) == 2
+    # the composite coil at ω* = 0.06 is strongly contracted, the pure LCE rod is not
+    comp = next(r for r in rows if r["quantity"] == "composite_length_L_over_L0")
+    pure = next(r for r in rows if r["quantity"] == "pure_lce_length_L_over_L0")
+    assert comp["predicted"] < 0.4 and 0.7 < pure["predicted"] < 0.95
+
+
+@pytest.mark.slow
+def test_report_and_figures(report):
+    md = (report / "report.md").read_text()
+    rows = json.loads((report / "summary.json").read_text())
+    for r in rows:
+        if r["predicted"] is not None:
+            assert f"{r['predicted']:.4g}" in md
+    figures = re.findall(r"!\[[^\]]*\]\((figures/[^)]+)\)", md)
+    assert len(figures) >= 6
+    for fig in figures:
+        path = report / fig
+        assert path.stat().st_size > 10_000, path
+        img = np.asarray(Image.open(path).convert("L"), dtype=float)
+        assert img.std() > 5.0, f"{fig} looks blank"
