@@ -9,11 +9,13 @@ Calibration (honest about what is fitted):
    fitted to v = 0.25 and 3 mm/s; v = 0.5 and 1.75 mm/s are predictions.
 
 Rotated filaments (v = 3 mm/s) use the closed-form free helix of notes 1.6 with model 2
-(identical to model 1 at v = 3 mm/s by construction). A rod-solver column will be added later.
+(identical to model 1 at v = 3 mm/s by construction). The ``rod_solver`` and ``rod_shape`` keys
+solve the same 30 mm filament (0.1 mm vertices) with the discrete elastic rod, heated 25 → 175 °C
+in 6 steps (:func:`rotomorph.simulate.filament.simulate_filament`); ``null`` if it fails.
 
 Run: ``python examples/filaments_vs_paper.py``. Keys per line: ``quantity, condition, measured,
 spread, predicted, calibration`` (bool, point used for fitting), ``model``, and ``shape``
-(morphology label) for filament lengths.
+(morphology label), ``rod_solver`` and ``rod_shape`` for filament lengths.
 """
 
 from __future__ import annotations
@@ -22,8 +24,28 @@ import json
 import sys
 from typing import Any
 
+from rotomorph.errors import RotomorphError
+from rotomorph.io.designfile import Filament
 from rotomorph.materials import EmpiricalThreshold, FilamentModel, calibrate, load_table
 from rotomorph.materials.calibrate import filament_shapes
+from rotomorph.simulate.filament import simulate_filament
+
+
+def rod_solver(model: FilamentModel, omega_star: float, fraction: float) -> tuple[Any, Any]:
+    """(L/L0, shape label) of a free 30 mm filament solved with the rod model, or (None, None)."""
+    program = Filament(
+        speed=3.0,
+        rotation_number=omega_star,
+        radius=0.3,
+        active_fraction=fraction,
+        spacing=0.1,
+        segments=[{"kind": "line", "length": 30.0}],  # type: ignore[list-item]
+    ).to_program()
+    try:
+        sim = simulate_filament(program, steps=6, model=model)
+    except RotomorphError:
+        return None, None
+    return round(sim.final_ratio, 4), sim.morphology.value
 
 
 def calibrated_models() -> dict[str, tuple[FilamentModel, Any]]:
@@ -61,6 +83,7 @@ def rows() -> list[dict[str, Any]]:
         data = load_table(table)
         shapes = filament_shapes(model, data.x, fraction)
         for i, shape in enumerate(shapes):
+            rod_ratio, rod_shape = rod_solver(model, float(data.x[i]), fraction)
             out.append(
                 {
                     "quantity": f"{table}_L_over_L0",
@@ -71,6 +94,8 @@ def rows() -> list[dict[str, Any]]:
                     "calibration": False,
                     "model": "empirical_threshold, closed-form helix",
                     "shape": shape.label,
+                    "rod_solver": rod_ratio,
+                    "rod_shape": rod_shape,
                 }
             )
     return out
