@@ -30,8 +30,13 @@ def test_free_and_clamped_free_helix_are_the_same_shape():
 def test_clamped_free_column_buckles_only_above_the_euler_load(factor, buckles):
     n, length, B = 41, 10.0, 1e-2
     s = np.linspace(0, length, n)
-    model = Model.chain(np.c_[s, 0 * s, 0 * s], bending_stiffness1=B, bending_stiffness2=B,
-                        twist_stiffness=B / 1.5, axial_stiffness=1e4)
+    model = Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=B,
+        bending_stiffness2=B,
+        twist_stiffness=B / 1.5,
+        axial_stiffness=1e4,
+    )
     p_cr = np.pi**2 * B / (4 * length**2)  # clamped-free (Euler), effective length 2L
     # start from a straight column with a tiny lateral imperfection of the tip
     state = model.reference_state()
@@ -42,8 +47,12 @@ def test_clamped_free_column_buckles_only_above_the_euler_load(factor, buckles):
     d1 = state.directors - np.sum(state.directors * t, axis=1, keepdims=True) * t
     d1 /= np.linalg.norm(d1, axis=1, keepdims=True)
     start = replace(state, positions=x, tangents=t, directors=d1)
-    res = solve_static(model, Supports.clamp_ends(n),
-                       Loads(forces=[(n - 1, (-factor * p_cr, 0.0, 0.0))]), initial=start)
+    res = solve_static(
+        model,
+        Supports.clamp_ends(n),
+        Loads(forces=[(n - 1, (-factor * p_cr, 0.0, 0.0))]),
+        initial=start,
+    )
     deflection = float(np.hypot(res.positions[-1, 1], res.positions[-1, 2]))
     if buckles:
         assert deflection > 0.2 * length

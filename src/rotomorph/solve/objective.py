@@ -199,6 +199,7 @@ class RodObjective:
         m[lay.theta] = self.model.rest_length**3
         self._metric = m[self.free]
         self._node_metric = m[lay.pos]
+        self._theta_metric = m[lay.theta]
         self._free_body = not self._fixed_mask.any()
         wt = np.ones(lay.count)
         wt[lay.theta] = 1.0 / lmean
@@ -372,18 +373,22 @@ class RodObjective:
     def project(self, d: FloatArray) -> FloatArray:
         """Remove the rigid motion from a step of a free body (M-orthogonal projection).
 
-        Rigid motions of an unsupported network are exact zero-energy modes; any component a
-        factorization puts along them is round-off. Translation and rotation about the
-        metric-weighted centroid are M-orthogonal, so the projection is closed-form. With any
-        support the step is returned unchanged (the remaining modes are handled by the shift).
+        Rigid motions of an unsupported network (translations; rotations, which also turn
+        every material frame by ``omega . t`` about its tangent) are exact zero-energy modes;
+        any component a factorization puts along them is round-off. With any support the step
+        is returned unchanged (the remaining modes are handled by the shift).
         """
         if not self._free_body:
             return d
         du = np.zeros(self.model.layout.count)
         du[self.free] = d
         dx = np.ascontiguousarray(du[self._pos_index].reshape(-1, 3))
-        remove_rigid_motion(self.base.positions, dx, self._node_metric)
+        dth = np.ascontiguousarray(du[self._theta_index])
+        remove_rigid_motion(
+            self.base.positions, dx, self._node_metric, self.base.tangents, dth, self._theta_metric
+        )
         du[self._pos_index] = dx.ravel()
+        du[self._theta_index] = dth
         return du[self.free]
 
     def curvature_step_scale(self, q: FloatArray, v: FloatArray) -> float:

@@ -192,41 +192,53 @@ def max_edge_rotation(x, dx, edges):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def remove_rigid_motion(x, dx, m):  # pragma: no cover - compiled
-    """Subtract from ``dx`` its M-orthogonal projection on rigid motions (in place).
+def remove_rigid_motion(x, dx, m, t, dtheta, mtheta):  # pragma: no cover - compiled
+    """Subtract from ``(dx, dtheta)`` its M-orthogonal projection on rigid motions (in place).
 
-    Translation and rotation about the ``m``-weighted centroid are ``m``-orthogonal, so the
-    projection is a translation plus ``omega x r`` with ``I omega = sum m r x dx``.
+    A small rigid rotation ``omega`` moves node ``i`` by ``omega x r_i`` *and* turns each edge's
+    material frame about its tangent by ``omega . t_j`` beyond parallel transport, so the twist
+    angles change by ``omega . t_j``. Translations (no twist part) and rotations about the
+    ``m``-weighted centroid are M-orthogonal, so the projection is a translation plus the
+    rotation solving ``G omega = b`` with
+    ``G = sum m (|r|^2 I - r r^T) + sum m_theta t t^T`` and
+    ``b = sum m r x dx + sum m_theta dtheta t``.
     """
     n = x.shape[0]
     mt = 0.0
     c = np.zeros(3)
-    t = np.zeros(3)
+    tr = np.zeros(3)
     for i in range(n):
         mt += m[i]
         for k in range(3):
             c[k] += m[i] * x[i, k]
-            t[k] += m[i] * dx[i, k]
+            tr[k] += m[i] * dx[i, k]
     for k in range(3):
         c[k] /= mt
-        t[k] /= mt
-    inertia = np.zeros((3, 3))
-    torque = np.zeros(3)
+        tr[k] /= mt
+    G = np.zeros((3, 3))
+    b = np.zeros(3)
     for i in range(n):
         r0, r1, r2 = x[i, 0] - c[0], x[i, 1] - c[1], x[i, 2] - c[2]
-        v0, v1, v2 = dx[i, 0] - t[0], dx[i, 1] - t[1], dx[i, 2] - t[2]
+        v0, v1, v2 = dx[i, 0] - tr[0], dx[i, 1] - tr[1], dx[i, 2] - tr[2]
         rr = r0 * r0 + r1 * r1 + r2 * r2
         r = (r0, r1, r2)
         for a in range(3):
-            inertia[a, a] += m[i] * rr
-            for b in range(3):
-                inertia[a, b] -= m[i] * r[a] * r[b]
-        torque[0] += m[i] * (r1 * v2 - r2 * v1)
-        torque[1] += m[i] * (r2 * v0 - r0 * v2)
-        torque[2] += m[i] * (r0 * v1 - r1 * v0)
-    omega = np.linalg.lstsq(inertia, torque)[0]
+            G[a, a] += m[i] * rr
+            for k in range(3):
+                G[a, k] -= m[i] * r[a] * r[k]
+        b[0] += m[i] * (r1 * v2 - r2 * v1)
+        b[1] += m[i] * (r2 * v0 - r0 * v2)
+        b[2] += m[i] * (r0 * v1 - r1 * v0)
+    for j in range(t.shape[0]):
+        for a in range(3):
+            b[a] += mtheta[j] * dtheta[j] * t[j, a]
+            for k in range(3):
+                G[a, k] += mtheta[j] * t[j, a] * t[j, k]
+    omega = np.linalg.lstsq(G, b)[0]
     for i in range(n):
         r0, r1, r2 = x[i, 0] - c[0], x[i, 1] - c[1], x[i, 2] - c[2]
-        dx[i, 0] -= t[0] + omega[1] * r2 - omega[2] * r1
-        dx[i, 1] -= t[1] + omega[2] * r0 - omega[0] * r2
-        dx[i, 2] -= t[2] + omega[0] * r1 - omega[1] * r0
+        dx[i, 0] -= tr[0] + omega[1] * r2 - omega[2] * r1
+        dx[i, 1] -= tr[1] + omega[2] * r0 - omega[0] * r2
+        dx[i, 2] -= tr[2] + omega[0] * r1 - omega[1] * r0
+    for j in range(t.shape[0]):
+        dtheta[j] -= omega[0] * t[j, 0] + omega[1] * t[j, 1] + omega[2] * t[j, 2]
