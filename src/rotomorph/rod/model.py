@@ -239,6 +239,28 @@ class Model:
         )
 
     @classmethod
+    def from_field(cls, points: FloatArray, field: object) -> Model:
+        """A printed filament through ``points`` ``(N, 3)`` (mm) with a natural ``field``.
+
+        ``field`` is a :class:`rotomorph.materials.natural.NaturalField` (or anything with its
+        attributes): per-edge ``directors``, stiffnesses and ``rest_length``, per-vertex
+        ``curvature1``, ``curvature2`` and ``twist`` (1/mm).
+        """
+        f = field
+        return cls.chain(
+            np.asarray(points, dtype=float),
+            bending_stiffness1=f.bending_stiffness1,  # type: ignore[attr-defined]
+            bending_stiffness2=f.bending_stiffness2,  # type: ignore[attr-defined]
+            twist_stiffness=f.twist_stiffness,  # type: ignore[attr-defined]
+            axial_stiffness=f.axial_stiffness,  # type: ignore[attr-defined]
+            directors=f.directors,  # type: ignore[attr-defined]
+            natural_curvature1=f.curvature1,  # type: ignore[attr-defined]
+            natural_curvature2=f.curvature2,  # type: ignore[attr-defined]
+            natural_twist=f.twist,  # type: ignore[attr-defined]
+            rest_length=f.rest_length,  # type: ignore[attr-defined]
+        )
+
+    @classmethod
     def chain(cls, points: FloatArray, **kwargs: object) -> Model:
         """A single filament through ``points`` ``(N, 3)`` (mm); keywords as for :class:`Model`."""
         return cls(Network.chain(points), **kwargs)  # type: ignore[arg-type]

@@ -166,18 +166,7 @@ def heating_temperatures(
 
 def rod_model(program: Any, field: NaturalField) -> Model:
     """The rod :class:`~rotomorph.rod.model.Model` of a printed filament with natural ``field``."""
-    return Model.chain(
-        np.asarray(program.points, dtype=float),
-        bending_stiffness1=field.bending_stiffness1,
-        bending_stiffness2=field.bending_stiffness2,
-        twist_stiffness=field.twist_stiffness,
-        axial_stiffness=field.axial_stiffness,
-        directors=field.directors,
-        natural_curvature1=field.curvature1,
-        natural_curvature2=field.curvature2,
-        natural_twist=field.twist,
-        rest_length=field.rest_length,
-    )
+    return Model.from_field(program.points, field)
 
 
 def _blend(a: NaturalField, b: NaturalField, w: float) -> NaturalField:
