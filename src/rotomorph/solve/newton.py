@@ -78,6 +78,8 @@ class NewtonOptions:
         indefinite (0 disables it).
     curvature_shift
         Relative shift above which the Hessian counts as indefinite for that search.
+    endgame
+        Residual below which free bodies get the rigid-rotation shift floor (see the loop).
     """
 
     max_iterations: int = 200
@@ -86,6 +88,7 @@ class NewtonOptions:
     armijo: float = 1e-4
     max_backtracks: int = 40
     curvature_iterations: int = 6
+    endgame: float = 1e-3
     curvature_shift: float = 1e-9
 
     def __post_init__(self) -> None:
@@ -136,9 +139,16 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         #    the exact Hessian was found indefinite, it is retried only after 1, 2, 4, ...
         #    iterations (backoff), so an indefinite phase costs no failed factorizations
         pure = skip_exact == 0
+        # rotating an unbalanced free body costs work of order |g|: in the end-game a shift of
+        # that order (Levenberg–Marquardt with mu ~ |g|, which keeps quadratic convergence)
+        # stops those rigid directions from failing the definiteness test (they are projected
+        # out anyway); far from equilibrium the Gauss–Newton path is the better one
+        floor = tau_min
+        if res < opt.endgame and hasattr(obj, "shift_floor"):
+            floor = max(floor, obj.shift_floor(g))
         if pure:
             n_fact += 1
-            fac = factorize(H, tau_min * M)
+            fac = factorize(H, floor * M)
             d = None if fac is None else fac.solve(-g)
             if d is None or not np.all(np.isfinite(d)):
                 pure, d = False, None
@@ -157,7 +167,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             #    definite, warm-started and relaxed only after a first try succeeded
             if first_try_ok:
                 tau = tau_min if tau <= 1e3 * tau_min else tau / 10.0
-            tau = max(tau, tau_min)
+            tau = max(tau, floor)
             first_try_ok = True
             while True:
                 n_fact += 1

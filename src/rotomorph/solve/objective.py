@@ -391,6 +391,24 @@ class RodObjective:
         du[self._theta_index] = dth
         return du[self.free]
 
+    def shift_floor(self, g: FloatArray) -> float:
+        """Smallest modified-Newton shift for a free body, 0 otherwise.
+
+        A small rigid rotation ``omega`` of an unbalanced body changes the energy at second
+        order by at most ``|omega|^2 sum |F_i| |r_i|`` (``F`` the nodal forces, ``r`` the
+        arms about the metric-weighted centroid), against ``|omega|^2 sum m_i |r_i|^2`` in the
+        metric: their ratio bounds how negative the rigid directions can be.
+        """
+        if not self._free_body:
+            return 0.0
+        gf = np.zeros(self.model.layout.count)
+        gf[self.free] = g
+        force = np.linalg.norm(gf[self._pos_index].reshape(-1, 3), axis=1)
+        m = self._node_metric
+        x = self.base.positions
+        arm = np.linalg.norm(x - m @ x / m.sum(), axis=1)
+        return 2.0 * float(force @ arm) / max(float(m @ arm**2), 1e-300)
+
     def curvature_step_scale(self, q: FloatArray, v: FloatArray) -> float:
         """Multiple of ``v`` that turns the most-turned edge by 0.2 rad."""
         angle = self._max_edge_rotation(v)
