@@ -14,6 +14,7 @@ reversed (tangent and ``m2`` flipped, twist angle negated, ``m1`` unchanged).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,8 +53,15 @@ class Stencils:
         return len(self.edge_e)
 
 
+_STENCILS: weakref.WeakKeyDictionary[Network, Stencils] = weakref.WeakKeyDictionary()
+_LAYOUTS: weakref.WeakKeyDictionary[Network, DofLayout] = weakref.WeakKeyDictionary()
+
+
 def build_stencils(network: Network) -> Stencils:
     """Stencils of ``network``: one per rod vertex, one per edge pair at each branch node.
+
+    Cached per (immutable) network, so models that differ only in their natural fields (a
+    heating ramp) share the topology work.
 
     Raises
     ------
@@ -61,6 +69,15 @@ def build_stencils(network: Network) -> Stencils:
         If a non-branch node has more than two edges, or the network has no stencil at all
         (a single segment cannot bend).
     """
+    cached = _STENCILS.get(network)
+    if cached is not None:
+        return cached
+    st = _build_stencils(network)
+    _STENCILS[network] = st
+    return st
+
+
+def _build_stencils(network: Network) -> Stencils:
     edges = network.edges
     incident: list[list[int]] = [[] for _ in range(network.n_nodes)]
     for j, (a, b) in enumerate(edges):
@@ -131,7 +148,16 @@ class DofLayout:
 
 
 def dof_layout(network: Network) -> DofLayout:
-    """Node-interleaved DOF layout of ``network`` (see :class:`DofLayout`)."""
+    """Node-interleaved DOF layout of ``network`` (see :class:`DofLayout`); cached."""
+    cached = _LAYOUTS.get(network)
+    if cached is not None:
+        return cached
+    layout = _dof_layout(network)
+    _LAYOUTS[network] = layout
+    return layout
+
+
+def _dof_layout(network: Network) -> DofLayout:
     starts = np.bincount(network.edges[:, 0], minlength=network.n_nodes)
     sizes = 3 + starts
     pos = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)

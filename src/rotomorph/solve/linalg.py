@@ -1,11 +1,13 @@
 """Factorizations of symmetric matrices that report positive definiteness.
 
 Modified Newton needs to know whether ``H + diag(shift)`` is positive definite. Banded matrices
-(single rods) use a compiled banded Cholesky (:mod:`rotomorph.solve.banded`), which fails on a
-non-positive pivot. General sparse matrices (networks) use SuperLU in symmetric mode with a
-symmetric fill-reducing ordering and no pivoting (``diag_pivot_thresh = 0``): then
-``P A P^T = L U`` with ``U = D L^T``, so by Sylvester's law of inertia ``A`` is positive definite
-exactly when every diagonal entry of ``U`` is positive. Dense matrices use LAPACK ``potrf``.
+(single rods) use a compiled banded Cholesky (:mod:`rotomorph.solve.banded`) and network
+Hessians a compiled sparse Cholesky with a cached symbolic analysis
+(:mod:`rotomorph.solve.sparse_cholesky`); both fail on a non-positive pivot. Other SciPy sparse
+matrices use SuperLU in symmetric mode with a symmetric fill-reducing ordering and no pivoting
+(``diag_pivot_thresh = 0``): then ``P A P^T = L U`` with ``U = D L^T``, so by Sylvester's law
+of inertia ``A`` is positive definite exactly when every diagonal entry of ``U`` is positive.
+Dense matrices use LAPACK ``potrf``.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from scipy.linalg import lapack
 
 from rotomorph._typing import FloatArray
 from rotomorph.solve.banded import banded_cholesky, banded_cholesky_solve
+from rotomorph.solve.sparse_cholesky import Symbolic, factor
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +54,24 @@ class BandedMatrix:
         return out
 
 
+@dataclass(frozen=True, eq=False)
+class SparseMatrix:
+    """A symmetric sparse matrix (full pattern, CSC) with its cached symbolic Cholesky."""
+
+    csc: sp.csc_matrix
+    symbolic: Symbolic
+
+    def diagonal(self) -> FloatArray:
+        """Main diagonal."""
+        return self.csc.diagonal()
+
+    def toarray(self) -> FloatArray:
+        """Dense copy (for tests)."""
+        return self.csc.toarray()
+
+    to_dense = toarray
+
+
 @njit(cache=True)
 def _banded_matvec(ab, u, x):  # pragma: no cover - compiled
     n = ab.shape[1]
@@ -75,6 +96,8 @@ def matvec(H: Any, x: FloatArray) -> FloatArray:
     """``H @ x`` for a banded, sparse or dense symmetric matrix."""
     if isinstance(H, BandedMatrix):
         return _banded_matvec(H.ab, H.u, x)
+    if isinstance(H, SparseMatrix):
+        return np.asarray(H.csc @ x)
     return np.asarray(H @ x)
 
 
@@ -89,7 +112,7 @@ class Factor:
         if self._kind == "banded":
             c, u = self._data
             return banded_cholesky_solve(c, u, rhs)
-        if self._kind == "sparse":
+        if self._kind in ("sparse", "cholesky"):
             return self._data.solve(rhs)
         x, _ = lapack.dpotrs(self._data, rhs, lower=0)
         return x
@@ -103,6 +126,9 @@ def factorize(H: Any, shift: FloatArray) -> Factor | None:
         if not banded_cholesky(work, H.u):
             return None
         return Factor("banded", (work, H.u))
+    if isinstance(H, SparseMatrix):
+        chol = factor(H.symbolic, H.csc.data, shift)
+        return None if chol is None else Factor("cholesky", chol)
     if sp.issparse(H):
         A = (H + sp.diags(shift)).tocsc()
         try:

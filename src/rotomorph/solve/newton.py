@@ -53,8 +53,24 @@ class Objective(Protocol):
     def accept(self, x: FloatArray) -> None:
         """Called with every accepted iterate (re-base frames, etc.)."""
 
+    def project(self, d: FloatArray) -> FloatArray:
+        """Remove exact zero-energy directions (e.g. free rigid motions) from a step."""
+
+    def max_step(self, x: FloatArray, d: FloatArray) -> float:
+        """Largest step fraction worth trying along ``d`` (1 when unlimited)."""
+
+    def shift_floor(self, g: FloatArray) -> float:
+        """Smallest shift for the end-game definiteness test (0 when not needed)."""
+
+    def convex_hessian(self, x: FloatArray) -> Any:
+        """A positive semidefinite Hessian approximation at ``x``, or None if there is none."""
+
+    def curvature_step_scale(self, x: FloatArray, v: FloatArray) -> float:
+        """Physical length to give a unit negative-curvature direction (0: use the step's)."""
+
     force_scale: float
     energy_scale: float
+    has_convex_hessian: bool
 
 
 @dataclass(frozen=True)
@@ -118,7 +134,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     tau_min = 1e-14 * tau_unit
     tau = 0.0
     first_try_ok = True
-    convex = hasattr(obj, "convex_hessian")
+    convex = obj.has_convex_hessian
     skip_exact = 0
     backoff = 0
     history: list[tuple[float, float, float, float]] = []
@@ -144,7 +160,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         # stops those rigid directions from failing the definiteness test (they are projected
         # out anyway); far from equilibrium the Gauss–Newton path is the better one
         floor = tau_min
-        if res < opt.endgame and hasattr(obj, "shift_floor"):
+        if res < opt.endgame:
             floor = max(floor, obj.shift_floor(g))
         if pure:
             n_fact += 1
@@ -184,19 +200,18 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 v = _negative_curvature_direction(fac, H, M, g, tau, opt.curvature_iterations)
                 if v is not None:
                     d = d + _scale_curvature_step(obj, x, v, d, M)
-        if hasattr(obj, "project"):
-            d = obj.project(d)
+        d = obj.project(d)
         slope = _dot(g, d)
         dec = -0.5 * slope / escale
         if pure and dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
-            x = obj.retract(x, d, min(1.0, obj.max_step(x, d)) if hasattr(obj, "max_step") else 1.0)
+            x = obj.retract(x, d, min(1.0, obj.max_step(x, d)))
             obj.accept(x)
             f, g, H = obj.evaluate(x, True, True)
             res = float(_norm(w * g)) / fscale
             history.append((f, res, 1.0, tau))
             status = Status.CONVERGED
             return _result(x, status, it, n_fact, f, res, dec, history)
-        alpha = min(1.0, obj.max_step(x, d)) if hasattr(obj, "max_step") else 1.0
+        alpha = min(1.0, obj.max_step(x, d))
         accepted = False
         for _ in range(opt.max_backtracks):
             xt = obj.retract(x, d, alpha)
@@ -268,9 +283,7 @@ def _negative_curvature_direction(fac, H, M, g, tau, iterations):  # type: ignor
 
 def _scale_curvature_step(obj, x, v, d, M):  # type: ignore[no-untyped-def]
     """Scale ``v`` to the larger of the step's M-norm and a physical move (objective-defined)."""
-    scale = np.sqrt(_dot(d, M * d))
-    if hasattr(obj, "curvature_step_scale"):
-        scale = max(scale, obj.curvature_step_scale(x, v))
+    scale = max(np.sqrt(_dot(d, M * d)), obj.curvature_step_scale(x, v))
     return scale * v
 
 
@@ -295,6 +308,7 @@ class FunctionObjective:
         self.fun, self.jac, self.hess = fun, jac, hess
         self.force_scale = force_scale
         self.energy_scale = energy_scale
+        self.has_convex_hessian = False
         self._n: int | None = None
 
     def evaluate(self, x, need_grad, need_hess):  # type: ignore[no-untyped-def]
@@ -316,3 +330,18 @@ class FunctionObjective:
 
     def accept(self, x: FloatArray) -> None:
         return None
+
+    def project(self, d: FloatArray) -> FloatArray:
+        return d
+
+    def max_step(self, x: FloatArray, d: FloatArray) -> float:
+        return 1.0
+
+    def shift_floor(self, g: FloatArray) -> float:
+        return 0.0
+
+    def convex_hessian(self, x: FloatArray) -> None:
+        return None
+
+    def curvature_step_scale(self, x: FloatArray, v: FloatArray) -> float:
+        return 0.0

@@ -7,10 +7,12 @@ Positions and twist angles of fixed DOFs keep their base values.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 import scipy.sparse as sp
 
-from rotomorph._typing import FloatArray, IntArray
+from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.assembly import (
     evaluate_network,
@@ -21,19 +23,22 @@ from rotomorph.rod.assembly import (
 )
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
-from rotomorph.solve.linalg import BandedMatrix
+from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.retraction import (
     EdgeRotationRetraction,
     max_edge_rotation,
     remove_rigid_motion,
 )
+from rotomorph.solve.sparse_cholesky import analyse
 
 BANDED_LIMIT = 64  # half-bandwidth above which the sparse path is used
 
 
 class RodObjective:
     """Static equilibrium of a :class:`~rotomorph.rod.model.Model` as an objective."""
+
+    has_convex_hessian = True  # the Gauss–Newton part of the stencil Hessians
 
     def __init__(self, model: Model, state: State, supports: Supports, loads: Loads) -> None:
         self.model = model
@@ -52,8 +57,8 @@ class RodObjective:
         for j in supports.fixed_twist_edges:
             fixed[lay.theta[_check_index("Supports.fixed_twist_edges", j, ne)]] = True
         self.free: IntArray = np.flatnonzero(~fixed)
-        fixed_nodes = np.flatnonzero(fixed[lay.pos[:, None] + np.arange(3)].all(axis=1))
-        self._retraction = EdgeRotationRetraction(self._edges, n, fixed_nodes)
+        topo = _topology(model, fixed)
+        self._retraction = topo["retraction"]
         reduced = -np.ones(lay.count, dtype=np.int64)
         reduced[self.free] = np.arange(len(self.free))
         self._reduced = reduced
@@ -98,7 +103,7 @@ class RodObjective:
         self._m1 = np.empty((ne, 3))
         self._m2 = np.empty((ne, 3))
         self._mref = np.empty(st.count)
-        self._setup_matrix()
+        self._setup_matrix(topo)
         self._fixed_mask = fixed
         self.set_base(state)
         self._setup_scales(loads)
@@ -134,40 +139,16 @@ class RodObjective:
             vecs.append(_vector("Loads.moments", moment))
         return np.array(edges, dtype=np.int64), np.array(vecs, dtype=float).reshape(-1, 3)
 
-    def _setup_matrix(self) -> None:
-        red = self._reduced
-        rs, re_ = red[self._st_dofs], red[self._ed_dofs]
-        spans = []
-        for r in (rs, re_):
-            if r.size:
-                big = np.iinfo(np.int64).max
-                hi = np.max(np.where(r >= 0, r, -1), axis=1)
-                lo = np.min(np.where(r >= 0, r, big), axis=1)
-                ok = hi >= 0
-                spans.append(int(np.max(hi[ok] - lo[ok])) if ok.any() else 0)
-        self.bandwidth = int(max(spans)) if spans else 0
+    def _setup_matrix(self, topo: dict) -> None:
+        self.bandwidth = topo["bandwidth"]
+        self.banded = topo["banded"]
         nfree = len(self.free)
-        self.banded = self.bandwidth <= BANDED_LIMIT
         if self.banded:
             self._ab = np.zeros((self.bandwidth + 1, nfree), order="F")
             return
-        rows = np.concatenate(
-            [np.repeat(rs, 11, axis=1).ravel(), np.repeat(re_, 6, axis=1).ravel()]
-        )
-        cols = np.concatenate([np.tile(rs, (1, 11)).ravel(), np.tile(re_, (1, 6)).ravel()])
-        ok = (rows >= 0) & (cols >= 0)
-        keys = np.where(ok, cols * nfree + rows, -1)
-        uniq, inv = np.unique(keys[ok], return_inverse=True)
-        slots = -np.ones(len(keys), dtype=np.int64)
-        slots[ok] = inv
-        ns = len(self._st_dofs) * 121
-        self._st_slot = slots[:ns].reshape(-1, 11, 11)
-        self._ed_slot = slots[ns:].reshape(-1, 6, 6)
-        indices = (uniq % nfree).astype(np.int32)
-        counts = np.bincount(uniq // nfree, minlength=nfree)
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
-        self._csc_pattern = (indices, indptr)
-        self._data = np.zeros(len(uniq))
+        self._st_slot, self._ed_slot, self._csc_pattern = topo["sparse"]
+        self._data = np.zeros(len(self._csc_pattern[0]))
+        self._topo = topo
 
     def _setup_scales(self, loads: Loads) -> None:
         net = self.model.network
@@ -368,7 +349,10 @@ class RodObjective:
         scatter_sparse(self._st_hess, self._st_slot, self._ed_hess, self._ed_slot, self._data)
         n = len(self.free)
         indices, indptr = self._csc_pattern
-        return sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
+        csc = sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
+        if self._topo.get("symbolic") is None:
+            self._topo["symbolic"] = analyse(csc)
+        return SparseMatrix(csc, self._topo["symbolic"])
 
     def project(self, d: FloatArray) -> FloatArray:
         """Remove the rigid motion from a step of a free body (M-orthogonal projection).
@@ -456,6 +440,58 @@ class RodObjective:
         u[self._pos_index] = self._retraction(pos, dpos, alpha).ravel()
         u[self._theta_index] += alpha * du[self._theta_index]
         return u[self.free]
+
+
+_TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _topology(model: Model, fixed: BoolArray) -> dict:
+    """Matrix structure and retraction of a network with given fixed DOFs (cached: a heating
+    ramp solves the same topology many times with different natural fields)."""
+    per_net = _TOPOLOGY.setdefault(model.network, {})
+    key = fixed.tobytes()
+    if key in per_net:
+        return per_net[key]
+    lay, st, net = model.layout, model.stencils, model.network
+    reduced = -np.ones(lay.count, dtype=np.int64)
+    free = np.flatnonzero(~fixed)
+    reduced[free] = np.arange(len(free))
+    rs, re_ = reduced[lay.stencil_dofs(st)], reduced[lay.edge_dofs(net.edges)]
+    spans = []
+    for r in (rs, re_):
+        if r.size:
+            hi = np.max(np.where(r >= 0, r, -1), axis=1)
+            lo = np.min(np.where(r >= 0, r, np.iinfo(np.int64).max), axis=1)
+            ok = hi >= 0
+            spans.append(int(np.max(hi[ok] - lo[ok])) if ok.any() else 0)
+    bandwidth = int(max(spans)) if spans else 0
+    topo: dict = {"bandwidth": bandwidth, "banded": bandwidth <= BANDED_LIMIT, "sparse": None}
+    if not topo["banded"]:
+        nfree = len(free)
+        rows = np.concatenate(
+            [np.repeat(rs, 11, axis=1).ravel(), np.repeat(re_, 6, axis=1).ravel()]
+        )
+        cols = np.concatenate([np.tile(rs, (1, 11)).ravel(), np.tile(re_, (1, 6)).ravel()])
+        ok = (rows >= 0) & (cols >= 0)
+        keys = cols[ok] * nfree + rows[ok]
+        uniq, inv = np.unique(keys, return_inverse=True)
+        slots = -np.ones(len(rows), dtype=np.int64)
+        slots[ok] = inv
+        ns = st.count * 121
+        indices = (uniq % nfree).astype(np.int32)
+        counts = np.bincount(uniq // nfree, minlength=nfree)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        topo["sparse"] = (
+            slots[:ns].reshape(-1, 11, 11),
+            slots[ns:].reshape(-1, 6, 6),
+            (indices, indptr),
+        )
+    fixed_nodes = np.flatnonzero(fixed[lay.pos[:, None] + np.arange(3)].all(axis=1))
+    topo["retraction"] = EdgeRotationRetraction(
+        np.ascontiguousarray(net.edges), net.n_nodes, fixed_nodes
+    )
+    per_net[key] = topo
+    return topo
 
 
 def _check_index(field: str, value: object, n: int) -> int:
