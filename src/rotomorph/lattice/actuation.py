@@ -1,0 +1,258 @@
+r"""How heating changes the natural state of lattice edges: pluggable, named actuation modes.
+
+An actuation maps a ramp parameter (the paper's x, or a temperature) to a rod
+:class:`~rotomorph.rod.model.Model` with new natural values. Only rod vertices are actuated;
+junction pairs keep their printed values (notes Q14), and the natural twist always stays
+printed. κ0 below is the printed pointwise curvature (both material components, so a stencil
+that straddles a flip is scaled as a vector).
+
+==============  =============================================================================
+name            natural curvature at ramp parameter x (expanding = active outer = "straightening",
+                contracting = active inner = "curling" edges)
+==============  =============================================================================
+``literal``     (a) the paper's words: κ̄ = (1 + x) κ0 on straightening, (1 − x) κ0 on curling
+                edges. Inverts the paper (expanding lattices contract, dome patterns give
+                saddles; notes Q4 and §6) — kept as a documented known fact.
+``swapped``     (b) labels swapped, **default** (notes Q4, §6): (1 − x) κ0 expanding,
+                (1 + x) κ0 contracting.
+``radius``      (c) c multiplies the radius of curvature: κ0/(1 + x) expanding, κ0/(1 − x)
+                contracting (4 κ0 at x = 0.75; curling edges loop through themselves).
+``additive``    (d) physical rule of notes 1.5: κ̄ = κ0 + x K_J toward the active side (K_J the
+                Janus curvature from the materials layer at the lattice's print speed, or given).
+``thermal``     temperature T (°C) → actuation fraction x(T) (materials layer); κ̄ = κ0 +
+                x(T) K_J toward the active side and rest lengths × exp(x ε_c) (centre-line
+                strain of the Janus section); printed turning angles are kept, so a pure axial
+                strain is a similarity.
+==============  =============================================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol, runtime_checkable
+
+import numpy as np
+
+from rotomorph.errors import InvalidParameterError
+from rotomorph.lattice.model import LatticeModel
+from rotomorph.materials.material import get_material
+from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.process import actuation_fraction
+from rotomorph.rod.model import Model
+
+__all__ = [
+    "ACTUATIONS",
+    "Actuation",
+    "AdditiveCurvature",
+    "CurvatureScaling",
+    "ThermalActuation",
+    "get_actuation",
+]
+
+ACTUATIONS = ("literal", "swapped", "radius", "additive", "thermal")
+
+#: Final ramp value of the paper's x (Methods: x from 0 to 0.75).
+PAPER_FINAL_X = 0.75
+
+
+@runtime_checkable
+class Actuation(Protocol):
+    """What :func:`rotomorph.lattice.heating.heat_lattice` needs from an actuation mode."""
+
+    name: str
+    start: float
+    end: float
+
+    def natural(self, lm: LatticeModel, parameter: float) -> Model:
+        """The rod model at ramp ``parameter``."""
+
+
+def _check_range(name: str, start: float, end: float) -> None:
+    for field, v in (("start", start), ("end", end)):
+        if not np.isfinite(v):
+            raise InvalidParameterError(f"{name}.{field}", f"must be finite; got {v}")
+
+
+@dataclass(frozen=True)
+class CurvatureScaling:
+    """Readings (a)-(c) of notes Q4: printed curvature multiplied by a factor c(x).
+
+    Parameters
+    ----------
+    reading
+        ``"literal"``, ``"swapped"`` or ``"radius"`` (module table).
+    start, end
+        Ramp of x (dimensionless); the paper ramps 0 → 0.75. ``radius`` needs x < 1.
+    """
+
+    reading: Literal["literal", "swapped", "radius"] = "swapped"
+    start: float = 0.0
+    end: float = PAPER_FINAL_X
+
+    def __post_init__(self) -> None:
+        if self.reading not in ("literal", "swapped", "radius"):
+            raise InvalidParameterError(
+                "CurvatureScaling.reading",
+                f"must be 'literal', 'swapped' or 'radius'; got {self.reading!r}",
+            )
+        _check_range("CurvatureScaling", self.start, self.end)
+        if self.reading == "radius" and max(abs(self.start), abs(self.end)) >= 1.0:
+            raise InvalidParameterError(
+                "CurvatureScaling.end", "must be < 1 for the 'radius' reading (κ0/(1 − x))"
+            )
+
+    @property
+    def name(self) -> str:
+        """The reading's name."""
+        return self.reading
+
+    def factors(self, x: float) -> tuple[float, float]:
+        """(c on expanding, c on contracting) edges at ramp value x."""
+        if self.reading == "literal":
+            return 1.0 + x, 1.0 - x
+        if self.reading == "swapped":
+            return 1.0 - x, 1.0 + x
+        return 1.0 / (1.0 + x), 1.0 / (1.0 - x)
+
+    def natural(self, lm: LatticeModel, parameter: float) -> Model:
+        """Scaled printed curvature on rod vertices, printed values on junction pairs."""
+        c_exp, c_con = self.factors(float(parameter))
+        c = np.where(lm.expanding, c_exp, np.where(lm.rod_vertex, c_con, 1.0))
+        k1, k2, _ = lm.printed
+        return lm.model.with_natural(curvature1=c * k1, curvature2=c * k2)
+
+
+def _janus_curvature(lm: LatticeModel, fm: FilamentModel) -> tuple[float, float]:
+    """(K_J toward n (1/mm), centre-line strain ε_c) at full actuation, ω* = 0."""
+    lat = lm.lattice
+    sec = fm.section(
+        get_material(lat.active_material),
+        get_material(lat.passive_material),
+        lat.radius,
+        lat.active_fraction,
+    )
+    e_par, e_perp, eps_p = fm.strains(np.array([lat.speed]), get_material(lat.passive_material))
+    eps_c, kappa, _ = sec.natural_strains(0.0, e_par, e_perp, eps_p)
+    return float(kappa[0, 0]), float(np.asarray(eps_c).reshape(-1)[0])
+
+
+def _additive(lm: LatticeModel, curvature: float, stretch: float = 1.0) -> Model:
+    k1, k2, _ = lm.printed
+    b1, b2 = lm.side_basis
+    rest = None if stretch == 1.0 else lm.model.network.edge_lengths * stretch
+    return lm.model.with_natural(
+        curvature1=k1 / stretch + curvature * b1,
+        curvature2=k2 / stretch + curvature * b2,
+        twist=None if stretch == 1.0 else lm.printed[2] / stretch,
+        rest_length=rest,
+    )
+
+
+@dataclass(frozen=True)
+class AdditiveCurvature:
+    """Reading (d): κ̄ = κ0 + x K_J toward the active side (notes 1.5).
+
+    Parameters
+    ----------
+    janus_curvature
+        K_J (1/mm); default: the materials layer's Janus curvature at the lattice's print speed
+        (0.59 mm⁻¹ at 3 mm/s with the calibrated modulus ratio).
+    start, end
+        Ramp of x (dimensionless).
+    filament_model
+        Materials modelling choices for the default K_J.
+    """
+
+    janus_curvature: float | None = None
+    start: float = 0.0
+    end: float = PAPER_FINAL_X
+    filament_model: FilamentModel | None = None
+    name: str = "additive"
+
+    def __post_init__(self) -> None:
+        _check_range("AdditiveCurvature", self.start, self.end)
+        if self.janus_curvature is not None and not np.isfinite(self.janus_curvature):
+            raise InvalidParameterError("AdditiveCurvature.janus_curvature", "must be finite")
+
+    def curvature(self, lm: LatticeModel) -> float:
+        """K_J used (1/mm)."""
+        if self.janus_curvature is not None:
+            return float(self.janus_curvature)
+        fm = FilamentModel() if self.filament_model is None else self.filament_model
+        return _janus_curvature(lm, fm)[0]
+
+    def natural(self, lm: LatticeModel, parameter: float) -> Model:
+        """Printed curvature plus x K_J toward the active side on rod vertices."""
+        return _additive(lm, float(parameter) * self.curvature(lm))
+
+
+@dataclass(frozen=True)
+class ThermalActuation:
+    """Physical mode: temperature (°C) → natural field from the materials layer.
+
+    Parameters
+    ----------
+    start, end
+        Temperature ramp (°C); the paper heats 25 → 150-175 °C.
+    filament_model
+        Materials modelling choices (strain model, modulus ratio, transition width).
+    """
+
+    start: float = 25.0
+    end: float = 175.0
+    filament_model: FilamentModel | None = None
+    name: str = "thermal"
+
+    def __post_init__(self) -> None:
+        _check_range("ThermalActuation", self.start, self.end)
+
+    def _fm(self) -> FilamentModel:
+        return FilamentModel() if self.filament_model is None else self.filament_model
+
+    def fraction(self, lm: LatticeModel, temperature: float) -> float:
+        """Actuation fraction x(T) ∈ [0, 1] (dimensionless)."""
+        fm = self._fm()
+        active = get_material(lm.lattice.active_material)
+        return float(
+            actuation_fraction(
+                temperature,
+                active.transition_temperature,  # type: ignore[arg-type]
+                fm.transition_width,
+                direction=fm.direction,
+                hysteresis=fm.hysteresis,
+            )
+        )
+
+    def natural(self, lm: LatticeModel, parameter: float) -> Model:
+        """Printed curvature plus x(T) K_J toward the active side, rest lengths × exp(x ε_c)."""
+        fm = self._fm()
+        x = self.fraction(lm, float(parameter))
+        k_j, eps_c = _janus_curvature(lm, fm)
+        strain = x * eps_c
+        stretch = float(np.exp(strain)) if fm.strain_model.measure == "hencky" else 1.0 + strain
+        return _additive(lm, x * k_j, stretch)
+
+
+def get_actuation(actuation: str | Actuation) -> Actuation:
+    """An actuation by name (module table) or the object itself.
+
+    Raises
+    ------
+    InvalidParameterError
+        Unknown name or an object without ``natural``/``start``/``end``.
+    """
+    if isinstance(actuation, str):
+        if actuation in ("literal", "swapped", "radius"):
+            return CurvatureScaling(actuation)  # type: ignore[arg-type]
+        if actuation == "additive":
+            return AdditiveCurvature()
+        if actuation == "thermal":
+            return ThermalActuation()
+        raise InvalidParameterError(
+            "actuation", f"must be one of {ACTUATIONS} or an Actuation object; got {actuation!r}"
+        )
+    if not isinstance(actuation, Actuation):
+        raise InvalidParameterError(
+            "actuation", "must have name, start, end and natural(lattice_model, parameter)"
+        )
+    return actuation

@@ -1,0 +1,412 @@
+r"""Heating ramps of printed lattices: quasi-static continuation from the flat printed state.
+
+:func:`heat_lattice` ramps an actuation (:mod:`rotomorph.lattice.actuation`) in equal steps,
+re-equilibrating each step from the previous equilibrium
+(:func:`rotomorph.solve.continuation.continuation`, halving failed steps). Symmetry breaking is
+deterministic: the first step starts from the printed state plus an out-of-plane perturbation
+``perturbation · l · (bump + 0.25 · noise)`` with a centred Gaussian bump (height 1, width a
+third of the lattice) and seeded normal noise. Which *side* a dome rises to may depend on the
+seed; the sign of the Gaussian curvature must not (tested on several seeds).
+
+Measurements per step (index 0 = the flat printed state): the normalised projected area of the
+boundary loop (paper Fig. 3G), the quadratic-surface fit of the branch nodes (Gaussian sign and
+characteristic curvature √|k1 k2|, Fig. 4), the mean edge strain and every edge's end-to-end
+ratio (Fig. 4C/F "strain", notes Q13), and the smallest distance between non-adjacent
+segments relative to the filament diameter (contact is not modelled: values < 1 mean filaments
+overlap, < 0 is impossible, so ``min_clearance`` ≈ 0 flags self-intersection).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.analysis.area import lattice_boundary_loop, normalized_area
+from rotomorph.analysis.curvature import fit_quadratic_surface
+from rotomorph.analysis.shape import edge_end_to_end_ratios, end_to_end_ratio
+from rotomorph.design.lattices import Lattice
+from rotomorph.errors import ConvergenceError, InvalidParameterError
+from rotomorph.geometry import parallel_transport, unit
+from rotomorph.lattice.actuation import Actuation, get_actuation
+from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
+from rotomorph.rod.assembly import reference_twist
+from rotomorph.rod.model import Model
+from rotomorph.rod.state import State
+from rotomorph.solve.continuation import continuation
+from rotomorph.solve.loads import Gravity, Loads, Supports
+from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.static import StaticResult, solve_static
+
+__all__ = [
+    "HeatingResult",
+    "free_edge_ratio",
+    "heat_lattice",
+    "lattice_gravity",
+    "perturbed_state",
+    "segment_clearance",
+]
+
+#: Newton settings of ramp steps: a residual of 1e-7 of the force scale is far below what the
+#: shape measures resolve, and it lets Newton stop near a bifurcation from the flat state, where
+#: the Hessian is nearly singular and convergence turns linear (a step at the saddle's onset
+#: took > 200 iterations at the solver's default 1e-9).
+RAMP_OPTIONS = NewtonOptions(rtol=1e-7, max_iterations=300)
+
+SupportsName = Literal["free", "clamped-boundary", "pinned-centre"]
+
+
+def perturbed_state(model: Model, dz: FloatArray) -> State:
+    """The printed state with node heights raised by ``dz`` ``(N,)`` (mm).
+
+    ``dz`` may also be a full displacement ``(N, 3)`` (mm). Tangents are recomputed, reference
+    directors parallel-transported from the printed tangents, twist angles zero and reference
+    twists unwrapped against the printed ones, so the material frames follow without twisting.
+    """
+    ref = model.reference_state()
+    dz = np.asarray(dz, dtype=float)
+    n = model.network.n_nodes
+    if dz.shape not in ((n,), (n, 3)) or not np.all(np.isfinite(dz)):
+        raise InvalidParameterError(
+            "dz", f"must be finite with shape ({n},) or ({n}, 3) mm; got {dz.shape}"
+        )
+    pos = ref.positions.copy()
+    if dz.ndim == 1:
+        pos[:, 2] += dz
+    else:
+        pos += dz
+    edges = model.network.edges
+    t = unit(pos[edges[:, 1]] - pos[edges[:, 0]])
+    d1 = unit(parallel_transport(ref.directors, ref.tangents, t))
+    st = model.stencils
+    mref = np.empty(st.count)
+    reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1, ref.reference_twist, mref)
+    return replace(ref, positions=pos, tangents=t, directors=d1, reference_twist=mref)
+
+
+def symmetry_breaking(lattice: Lattice, amplitude: float, seed: int) -> FloatArray:
+    """Out-of-plane perturbation ``(N,)`` (mm): ``amplitude · (bump + 0.25 · noise)``."""
+    x = lattice.network.nodes
+    centre = x[lattice.branch_indices].mean(axis=0)
+    size = lattice.spacing * (lattice.n - 1)
+    r2 = np.sum((x[:, :2] - centre[:2]) ** 2, axis=1)
+    bump = np.exp(-0.5 * r2 / (size / 3.0) ** 2)
+    noise = np.random.default_rng(seed).standard_normal(len(x))
+    return amplitude * (bump + 0.25 * noise)
+
+
+def segment_clearance(
+    positions: FloatArray, edges: IntArray, diameter: float, *, cap: float = 2.0
+) -> float:
+    """Smallest distance between segments sharing no node, in filament diameters.
+
+    ≥ 1: no two filaments touch; in (0, 1): they overlap (no contact model); ≈ 0: they cross.
+    Exact segment–segment distances (clamped closest points) for the candidate pairs whose
+    midpoints lie within ``cap`` diameters plus the longest segment; ``cap`` is returned when
+    no pair is that close.
+    """
+    p0 = positions[edges[:, 0]]
+    u = positions[edges[:, 1]] - p0
+    mid = p0 + 0.5 * u
+    reach = cap * diameter + float(np.linalg.norm(u, axis=1).max())
+    pairs = cKDTree(mid).query_pairs(reach, output_type="ndarray")
+    if len(pairs):
+        i, j = pairs[:, 0], pairs[:, 1]
+        share = (edges[i][:, :, None] == edges[j][:, None, :]).any(axis=(1, 2))
+        i, j = i[~share], j[~share]
+    if not len(pairs) or not len(i):
+        return cap
+    a, b = u[i], u[j]
+    w = p0[i] - p0[j]
+    aa, bb, ab = (np.einsum("ij,ij->i", *v) for v in ((a, a), (b, b), (a, b)))
+    aw, bw = np.einsum("ij,ij->i", a, w), np.einsum("ij,ij->i", b, w)
+    den = aa * bb - ab**2
+    ok = den > 1e-12 * aa * bb
+    s = np.clip(np.where(ok, (ab * bw - bb * aw) / np.where(ok, den, 1.0), 0.0), 0.0, 1.0)
+    t = np.clip((ab * s + bw) / bb, 0.0, 1.0)
+    s = np.clip((ab * t - aw) / aa, 0.0, 1.0)
+    d = np.linalg.norm(w + s[:, None] * a - t[:, None] * b, axis=1)
+    return float(min(cap, d.min() / diameter))
+
+
+@dataclass(frozen=True, eq=False)
+class HeatingResult:
+    """A heating ramp of a lattice; per-step arrays have ``steps + 1`` rows (row 0: printed).
+
+    Attributes
+    ----------
+    parameter
+        Ramp parameter (x, dimensionless, or T in °C for ``thermal``).
+    positions
+        Node positions ``(steps+1, N, 3)`` (mm).
+    energy
+        Elastic energy at equilibrium (N mm; 0 when printed).
+    iterations
+        Newton iterations spent reaching each step (halved sub-steps included).
+    halvings
+        Deepest step halving used to reach each step.
+    residual
+        Relative residual of each equilibrium.
+    area_ratio
+        Projected area of the boundary loop over the printed one (A/A0).
+    gaussian_sign
+        Sign of the fitted Gaussian curvature of the branch nodes (+1 dome, −1 saddle, 0 flat).
+    characteristic_curvature
+        √|k1 k2| of that fit (1/mm).
+    mean_edge_strain
+        Mean end-to-end strain of the lattice edges (dimensionless).
+    edge_ratios
+        End-to-end ratio of every lattice edge ``(steps+1, n_edges)``.
+    min_clearance
+        :func:`segment_clearance` per step (filament diameters).
+    wall_time
+        Seconds per step (0 for the printed row).
+    lattice, model, actuation
+        The design, its :class:`LatticeModel` and the actuation's name.
+    """
+
+    parameter: FloatArray
+    positions: FloatArray
+    energy: FloatArray
+    iterations: IntArray
+    halvings: IntArray
+    residual: FloatArray
+    area_ratio: FloatArray
+    gaussian_sign: IntArray
+    characteristic_curvature: FloatArray
+    mean_edge_strain: FloatArray
+    edge_ratios: FloatArray
+    min_clearance: FloatArray
+    wall_time: FloatArray
+    lattice: Lattice
+    model: LatticeModel
+    actuation: str
+
+    @property
+    def final_area_ratio(self) -> float:
+        """A/A0 at the end of the ramp."""
+        return float(self.area_ratio[-1])
+
+    @property
+    def total_iterations(self) -> int:
+        """Newton iterations over the whole ramp."""
+        return int(self.iterations.sum())
+
+    def first_overlap(self, threshold: float = 1.0) -> float | None:
+        """First ramp parameter at which filaments come closer than ``threshold`` diameters."""
+        hit = np.flatnonzero(self.min_clearance < threshold)
+        return None if not len(hit) else float(self.parameter[hit[0]])
+
+
+def _supports(lattice: Lattice, name: str) -> Supports:
+    if name == "free":
+        return Supports()
+    if name == "pinned-centre":
+        c = lattice.n // 2
+        return Supports(pinned_nodes=(lattice.branch_index(c, c),))
+    if name == "clamped-boundary":
+        n = lattice.n
+        i, j = np.divmod(lattice.branch_indices, n)
+        rim = set(lattice.branch_indices[(i == 0) | (j == 0) | (i == n - 1) | (j == n - 1)])
+        edges = lattice.network.edges
+        clamped = np.flatnonzero(np.isin(edges[:, 0], list(rim)) | np.isin(edges[:, 1], list(rim)))
+        return Supports(clamped_edges=tuple(int(k) for k in clamped))
+    raise InvalidParameterError(
+        "supports", f"must be 'free', 'clamped-boundary' or 'pinned-centre'; got {name!r}"
+    )
+
+
+def lattice_gravity(
+    lattice: Lattice, *, fluid_density: float = 0.97, density: float | None = None
+) -> Gravity:
+    """Self-weight of a lattice's filaments with buoyancy (notes Q15), all layers lumped.
+
+    Parameters
+    ----------
+    fluid_density
+        Density of the bath (g/cm³); silicone oil ≈ 0.97.
+    density
+        Filament density (g/cm³); default the mean of the lattice's two inks (materials table).
+    """
+    from rotomorph.materials.material import get_material
+
+    if density is None:
+        density = 0.5 * (
+            float(get_material(lattice.active_material).density or 1.1)
+            + float(get_material(lattice.passive_material).density or 1.1)
+        )
+    area = lattice.layers * np.pi * lattice.radius**2
+    return Gravity(density=density, area=area, fluid_density=fluid_density)
+
+
+def _measure(lattice: Lattice, pos: FloatArray, ref: FloatArray, loop: IntArray) -> tuple:
+    fit = fit_quadratic_surface(pos[lattice.branch_indices], flat_tolerance=1e-6)
+    return (
+        normalized_area(pos, ref, loop),
+        fit.gaussian_sign,
+        fit.characteristic_curvature,
+        edge_end_to_end_ratios(pos, ref, lattice.edge_chains),
+        segment_clearance(pos, lattice.network.edges, 2.0 * lattice.radius),
+    )
+
+
+def heat_lattice(
+    lattice: Lattice,
+    *,
+    actuation: str | Actuation = "swapped",
+    steps: int = 16,
+    stiffness: Stiffness = "paper",
+    supports: SupportsName = "free",
+    gravity: Gravity | None = None,
+    seed: int = 0,
+    perturbation: float = 1e-3,
+    options: NewtonOptions | None = None,
+    max_halvings: int = 6,
+) -> HeatingResult:
+    """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
+
+    Parameters
+    ----------
+    lattice
+        The printed design (:func:`rotomorph.design.lattices.sinusoidal_lattice`).
+    actuation
+        A name of :data:`rotomorph.lattice.actuation.ACTUATIONS` (default ``"swapped"``,
+        notes Q4) or an actuation object; its ``start``/``end`` set the ramp.
+    steps
+        Equal ramp steps (>= 1).
+    stiffness
+        ``"paper"`` or ``"janus"`` (:func:`rotomorph.lattice.model.lattice_model`).
+    supports
+        ``"free"`` (default; the paper's free lattice), ``"clamped-boundary"`` (every segment
+        touching a perimeter branch node clamped: position and frame fixed) or
+        ``"pinned-centre"`` (the central branch node pinned, e.g. to carry gravity).
+    gravity
+        Optional self-weight (:func:`lattice_gravity`); needs supports other than ``"free"``.
+    seed
+        Seed of the symmetry-breaking noise.
+    perturbation
+        Height of the symmetry-breaking perturbation relative to the spacing l (>= 0).
+    options
+        Newton settings of every solve; default :data:`RAMP_OPTIONS`.
+    max_halvings
+        Step halvings allowed per ramp step.
+
+    Returns
+    -------
+    HeatingResult
+
+    Raises
+    ------
+    InvalidParameterError
+        Bad steps, perturbation, supports or stiffness option; gravity on a free lattice.
+    ConvergenceError
+        A ramp step failed after ``max_halvings`` halvings (``error.result`` holds the steps
+        reached).
+    """
+    act = get_actuation(actuation)
+    if int(steps) != steps or steps < 1:
+        raise InvalidParameterError("steps", f"must be an integer >= 1; got {steps}")
+    if not (np.isfinite(perturbation) and perturbation >= 0):
+        raise InvalidParameterError(
+            "perturbation", f"must be >= 0 (relative to l); got {perturbation}"
+        )
+    options = RAMP_OPTIONS if options is None else options
+    sup = _supports(lattice, supports)
+    if gravity is not None and sup.is_free:
+        raise InvalidParameterError(
+            "supports", "gravity needs a support: use 'pinned-centre' or 'clamped-boundary'"
+        )
+    lm = lattice_model(lattice, stiffness=stiffness)
+    loads = Loads(gravity=gravity)
+    dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
+    initial = perturbed_state(lm.model, dz)
+    values = np.linspace(act.start, act.end, int(steps) + 1)
+
+    events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
+
+    def solve(p: float, state: State) -> StaticResult:
+        try:
+            res = solve_static(act.natural(lm, p), sup, loads, initial=state, options=options)
+        except ConvergenceError as err:
+            events.append((p, int(getattr(err.result, "iterations", 0)), False))
+            raise
+        events.append((p, res.iterations, True))
+        return res
+
+    path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
+    ref = lattice.network.nodes
+    loop = lattice_boundary_loop(lattice.edge_chains, lattice.n)
+    positions = np.stack([ref] + [r.positions for r in path.results])
+    energy = np.array([0.0] + [r.energy for r in path.results])
+    residual = np.array([0.0] + [r.residual for r in path.results])
+    iterations = np.zeros(len(values), dtype=np.int64)
+    k = 1
+    for p, its, ok in events:  # sub-steps and failed attempts count toward their step
+        iterations[k] += its
+        if ok and k < len(values) and p == path.steps[k - 1].parameter:
+            k += 1
+    halvings = np.array([0] + [s.halvings for s in path.steps], dtype=np.int64)
+    wall = np.array([0.0] + [s.wall_time for s in path.steps])
+    rows = [_measure(lattice, p, ref, loop) for p in positions]
+    ratios = np.stack([r[3] for r in rows])
+    return HeatingResult(
+        parameter=values,
+        positions=positions,
+        energy=energy,
+        iterations=iterations,
+        halvings=halvings,
+        residual=residual,
+        area_ratio=np.array([r[0] for r in rows]),
+        gaussian_sign=np.array([r[1] for r in rows], dtype=np.int64),
+        characteristic_curvature=np.array([r[2] for r in rows]),
+        mean_edge_strain=ratios.mean(axis=1) - 1.0,
+        edge_ratios=ratios,
+        min_clearance=np.array([r[4] for r in rows]),
+        wall_time=wall,
+        lattice=lattice,
+        model=lm,
+        actuation=act.name,
+    )
+
+
+def free_edge_ratio(
+    lattice: Lattice,
+    *,
+    actuation: str | Actuation = "swapped",
+    parameter: float | None = None,
+    edge: int = 0,
+    steps: int = 8,
+    stiffness: Stiffness = "paper",
+) -> float:
+    """End-to-end ratio L/L0 of one lattice edge printed alone and actuated freely.
+
+    The single sinusoid of paper Fig. 3C/D (1.37 ± 0.07 expanding, 0.64 ± 0.05 contracting);
+    for a homogeneous lattice the area ratio is this ratio squared (notes C1, 2.7).
+
+    Parameters
+    ----------
+    lattice
+        Supplies the edge geometry, mode, active sides and printing parameters.
+    actuation
+        As :func:`heat_lattice`.
+    parameter
+        Ramp value to reach (default: the actuation's ``end``); reached by continuation in
+        ``steps`` equal steps from its ``start``.
+    edge
+        Which lattice edge (its mode decides expanding/contracting).
+    """
+    act = get_actuation(actuation)
+    lm = edge_model(lattice, edge, stiffness=stiffness)
+    end = act.end if parameter is None else float(parameter)
+    values = np.linspace(act.start, end, int(steps) + 1)[1:]
+    path = continuation(
+        lambda p, s: solve_static(act.natural(lm, p), initial=s),
+        values,
+        lm.model.reference_state(),
+        start=act.start,
+    )
+    ref = lm.model.network.nodes
+    return end_to_end_ratio(path.final.positions, ref)
