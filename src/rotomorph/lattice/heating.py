@@ -12,8 +12,9 @@ Measurements per step (index 0 = the flat printed state): the normalised project
 boundary loop (paper Fig. 3G), the quadratic-surface fit of the branch nodes (Gaussian sign and
 characteristic curvature √|k1 k2|, Fig. 4), the mean edge strain and every edge's end-to-end
 ratio (Fig. 4C/F "strain", notes Q13), and the smallest distance between non-adjacent
-segments relative to the filament diameter (contact is not modelled: values < 1 mean filaments
-overlap, < 0 is impossible, so ``min_clearance`` ≈ 0 flags self-intersection).
+segments relative to the filament diameter, ignoring pairs already closer than a diameter as
+printed (fused at junctions). Contact is not modelled: values < 1 mean filaments overlap and
+``min_clearance`` ≈ 0 flags filaments passing through each other.
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from rotomorph.solve.static import StaticResult, solve_static
 __all__ = [
     "HeatingResult",
     "free_edge_ratio",
+    "fused_pairs",
     "heat_lattice",
     "lattice_gravity",
     "perturbed_state",
@@ -98,27 +100,19 @@ def symmetry_breaking(lattice: Lattice, amplitude: float, seed: int) -> FloatArr
     return amplitude * (bump + 0.25 * noise)
 
 
-def segment_clearance(
-    positions: FloatArray, edges: IntArray, diameter: float, *, cap: float = 2.0
-) -> float:
-    """Smallest distance between segments sharing no node, in filament diameters.
-
-    ≥ 1: no two filaments touch; in (0, 1): they overlap (no contact model); ≈ 0: they cross.
-    Exact segment–segment distances (clamped closest points) for the candidate pairs whose
-    midpoints lie within ``cap`` diameters plus the longest segment; ``cap`` is returned when
-    no pair is that close.
-    """
+def _pair_distances(
+    positions: FloatArray, edges: IntArray, reach: float
+) -> tuple[IntArray, FloatArray]:
+    """Segment pairs sharing no node whose midpoints lie within ``reach`` plus the longest
+    segment, with their exact distances (clamped closest points) (mm)."""
     p0 = positions[edges[:, 0]]
     u = positions[edges[:, 1]] - p0
     mid = p0 + 0.5 * u
-    reach = cap * diameter + float(np.linalg.norm(u, axis=1).max())
-    pairs = cKDTree(mid).query_pairs(reach, output_type="ndarray")
-    if len(pairs):
-        i, j = pairs[:, 0], pairs[:, 1]
-        share = (edges[i][:, :, None] == edges[j][:, None, :]).any(axis=(1, 2))
-        i, j = i[~share], j[~share]
-    if not len(pairs) or not len(i):
-        return cap
+    r = reach + float(np.linalg.norm(u, axis=1).max())
+    pairs = cKDTree(mid).query_pairs(r, output_type="ndarray").reshape(-1, 2)
+    share = (edges[pairs[:, 0]][:, :, None] == edges[pairs[:, 1]][:, None, :]).any(axis=(1, 2))
+    pairs = pairs[~share]
+    i, j = pairs[:, 0], pairs[:, 1]
     a, b = u[i], u[j]
     w = p0[i] - p0[j]
     aa, bb, ab = (np.einsum("ij,ij->i", *v) for v in ((a, a), (b, b), (a, b)))
@@ -128,8 +122,35 @@ def segment_clearance(
     s = np.clip(np.where(ok, (ab * bw - bb * aw) / np.where(ok, den, 1.0), 0.0), 0.0, 1.0)
     t = np.clip((ab * s + bw) / bb, 0.0, 1.0)
     s = np.clip((ab * t - aw) / aa, 0.0, 1.0)
-    d = np.linalg.norm(w + s[:, None] * a - t[:, None] * b, axis=1)
-    return float(min(cap, d.min() / diameter))
+    return pairs, np.linalg.norm(w + s[:, None] * a - t[:, None] * b, axis=1)
+
+
+def segment_clearance(
+    positions: FloatArray,
+    edges: IntArray,
+    diameter: float,
+    *,
+    cap: float = 2.0,
+    ignore: IntArray | None = None,
+) -> float:
+    """Smallest distance between segments sharing no node, in filament diameters.
+
+    ≥ 1: no two filaments touch; in (0, 1): they overlap (no contact model); ≈ 0: they cross.
+    ``cap`` is returned when no pair is closer. ``ignore`` ``(P, 2)`` lists segment pairs
+    ``i < j`` to skip (e.g. those already fused where filaments cross at a printed junction).
+    """
+    pairs, dist = _pair_distances(positions, edges, cap * diameter)
+    if ignore is not None and len(ignore) and len(pairs):
+        n = len(edges)
+        skip = np.isin(pairs[:, 0] * n + pairs[:, 1], ignore[:, 0] * n + ignore[:, 1])
+        dist = dist[~skip]
+    return float(min(cap, dist.min() / diameter)) if len(dist) else cap
+
+
+def fused_pairs(positions: FloatArray, edges: IntArray, diameter: float) -> IntArray:
+    """Segment pairs ``(P, 2)`` closer than ``diameter`` (mm) in ``positions`` (printed: fused)."""
+    pairs, dist = _pair_distances(positions, edges, diameter)
+    return pairs[dist < diameter]
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,14 +263,18 @@ def lattice_gravity(
     return Gravity(density=density, area=area, fluid_density=fluid_density)
 
 
-def _measure(lattice: Lattice, pos: FloatArray, ref: FloatArray, loop: IntArray) -> tuple:
-    fit = fit_quadratic_surface(pos[lattice.branch_indices], flat_tolerance=1e-6)
+def _measure(
+    lattice: Lattice, pos: FloatArray, ref: FloatArray, loop: IntArray, fused: IntArray
+) -> tuple:
+    # the branch nodes (paper, notes 2.7); a 2 x 2 lattice has too few, so all its nodes
+    pts = pos[lattice.branch_indices] if lattice.n >= 3 else pos
+    fit = fit_quadratic_surface(pts, flat_tolerance=1e-6)
     return (
         normalized_area(pos, ref, loop),
         fit.gaussian_sign,
         fit.characteristic_curvature,
         edge_end_to_end_ratios(pos, ref, lattice.edge_chains),
-        segment_clearance(pos, lattice.network.edges, 2.0 * lattice.radius),
+        segment_clearance(pos, lattice.network.edges, 2.0 * lattice.radius, ignore=fused),
     )
 
 
@@ -350,7 +375,8 @@ def heat_lattice(
             k += 1
     halvings = np.array([0] + [s.halvings for s in path.steps], dtype=np.int64)
     wall = np.array([0.0] + [s.wall_time for s in path.steps])
-    rows = [_measure(lattice, p, ref, loop) for p in positions]
+    fused = fused_pairs(ref, lattice.network.edges, 2.0 * lattice.radius)
+    rows = [_measure(lattice, p, ref, loop, fused) for p in positions]
     ratios = np.stack([r[3] for r in rows])
     return HeatingResult(
         parameter=values,
