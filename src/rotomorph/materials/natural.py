@@ -151,7 +151,10 @@ class NaturalField:
     Attributes
     ----------
     directors
-        ``(N-1, 3)`` unit interface normals n = m1 of the edges (into the active phase).
+        ``(N-1, 3)`` unit material directors m1 = ±n of the edges: the interface normal n (into
+        the active phase) or its opposite, signed so that the directors have no π jumps where
+        the active side flips (see :func:`continuous_sign`); the curvature increments carry the
+        side.
     curvature1, curvature2, twist
         ``(N-2,)`` natural curvature toward m1, m2 and twist at interior vertices (1/mm); the rod
         core multiplies them by its Voronoi length to get integrated values. The printed part is
@@ -269,6 +272,20 @@ def _check_handedness(k1: FloatArray, k2: FloatArray, tw: FloatArray, w: FloatAr
             )
 
 
+def continuous_sign(normals: FloatArray, tangents: FloatArray) -> FloatArray:
+    """Signs ``(E,)`` making ``sign * normals`` continuous along a filament.
+
+    An edge's sign flips when its normal points against the parallel transport of the previous
+    edge's signed normal (an interface flip by about pi).
+    """
+    sign = np.ones(len(normals))
+    if len(normals) > 1:
+        prev = geometry.parallel_transport(normals[:-1], tangents[:-1], tangents[1:])
+        flips = np.einsum("ij,ij->i", prev, normals[1:]) < 0.0
+        sign[1:] = np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)
+    return sign
+
+
 def natural_field(
     program: Any,
     materials: Mapping[str, Material] | None = None,
@@ -324,7 +341,13 @@ def natural_field(
 
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
-    directors = geometry.rotate_about_tangent(d1, t, alpha)
+    normals = geometry.rotate_about_tangent(d1, t, alpha)
+    # m1 = sign * n: the same principal axis, but without the pi jumps of n where the active
+    # side flips (a DER vertex averages its two edges' frames, which vanish across a pi jump
+    # and would leave a stiffness-free hinge there); the side is carried by the sign
+    sign = continuous_sign(normals, t)
+    directors = sign[:, None] * normals
+    kappa = sign[:, None] * kappa
     k1, k2, tw, vor = geometry.polyline_strains(pts, directors)
     _check_handedness(k1, k2, tw, omega_star)
 
