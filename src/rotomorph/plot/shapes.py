@@ -203,7 +203,9 @@ def plot_lattice_views(
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)" if name == "top" else "z (mm)")
-        ax.set_title(f"{title} {name} view".strip())
+        ax.set_title(f"{name} view")
+    if title:
+        fig.suptitle(title)
     if mappable is not None:
         fig.colorbar(mappable, ax=[top, side], shrink=0.8, label=label)
     return fig

@@ -355,6 +355,12 @@ def _heat(pattern: str, quick: bool, steps: int) -> tuple[Any, Any, str]:
         return lattice, None, f"lattice solver failed: {' '.join(str(err).split())[:160]}"
 
 
+def _contact_free(res: Any) -> int:
+    """Index of the last ramp step before filaments come within one diameter of each other."""
+    hit = np.flatnonzero(np.asarray(res.min_clearance) < 1.0)
+    return int(max(hit[0] - 1, 0)) if len(hit) else len(res.parameter) - 1
+
+
 def _lattice_section(
     figs: Path, *, quick: bool, steps: int, tick: Callable[[], None]
 ) -> tuple[list[dict], list[Path]]:
@@ -392,8 +398,27 @@ def _lattice_section(
                 f"modelled (min clearance {np.min(res.min_clearance):.2f} diameters)",
             )
         )
+        if res is not None and pattern == "contracting":
+            k = _contact_free(res)
+            rows.append(
+                _row(
+                    "lattice_area_ratio",
+                    f"{table.condition[i]}, at first self-contact (jamming bound)",
+                    measured,
+                    spread,
+                    float(res.area_ratio[k]),
+                    unit="1",
+                    figure="fig3g_lattice_area.png",
+                    note=f"{size}; last ramp step (x = {res.parameter[k]:.2f}) before "
+                    "neighbouring filaments come within one diameter: contact, which the "
+                    "paper says jams the contracting lattice, would stop contraction here",
+                )
+            )
         if res is not None:
             ax.plot(res.parameter, res.area_ratio, "o-", ms=3, label=f"{pattern} (model)")
+            k = _contact_free(res)
+            if k < len(res.parameter) - 1:
+                ax.axvline(res.parameter[k], color="0.6", ls=":", lw=1)
         ax.errorbar([0.75], [measured], yerr=[spread], fmt="s", capsize=3,
                     label=f"{pattern} (measured, 175 °C)")  # fmt: skip
     ax.set_xlabel("actuation parameter x (–)")
@@ -402,22 +427,28 @@ def _lattice_section(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     paths.append(save_figure(fig, figs / "fig3g_lattice_area.png"))
-    # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i
+    # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i, at the last contact-free step
+    # (what the elastic model can claim) and, where later, at the end of the ramp
     for pattern in ("expanding", "contracting", "dome", "saddle"):
         lattice, res, _ = results[pattern]
         if res is None:
             continue
-        rel = network_relative_curvature_change(
-            res.positions[-1], res.positions[0], lattice.edge_chains
-        )
-        f = plot_lattice_views(
-            res.positions[-1],
-            lattice.network.edges,
-            rel,
-            label="(κ − κ_i)/κ_i",
-            title=f"{pattern}, x = {res.parameter[-1]:.2f}",
-        )
-        paths.append(save_figure(f, figs / f"lattice_{pattern}_views.png"))
+        k_free, k_end = _contact_free(res), len(res.parameter) - 1
+        for k, suffix in ((k_free, ""), (k_end, "_final")):
+            if suffix and k == k_free:
+                continue
+            rel = network_relative_curvature_change(
+                res.positions[k], res.positions[0], lattice.edge_chains
+            )
+            state = "before self-contact" if not suffix else "self-intersecting, no contact model"
+            f = plot_lattice_views(
+                res.positions[k],
+                lattice.network.edges,
+                rel,
+                label="(κ − κ_i)/κ_i",
+                title=f"{pattern}, x = {res.parameter[k]:.2f} ({state})",
+            )
+            paths.append(save_figure(f, figs / f"lattice_{pattern}_views{suffix}.png"))
     # Fig. 4C/F: sign and characteristic curvature vs strain
     fig = new_figure(10.0, 4.0)
     axes = fig.subplots(1, 2)
@@ -425,16 +456,20 @@ def _lattice_section(
         axes, (("dome", 1, "4C"), ("saddle", -1, "4F")), strict=True
     ):
         lattice, res, why = results[pattern]
+        k = 0 if res is None else _contact_free(res)
         rows.append(
             _row(
                 "lattice_gaussian_sign",
                 f"{pattern} lattice",
                 float(sign),
                 0.0,
-                None if res is None else float(res.gaussian_sign[-1]),
+                None if res is None else float(res.gaussian_sign[k]),
                 unit="1",
                 figure="fig4cf_characteristic_curvature.png",
-                note=why or f"{size}; sign of the fitted Gaussian curvature of the branch nodes",
+                note=why
+                or f"{size}; sign of the fitted Gaussian curvature of the branch nodes at the "
+                f"last contact-free step x = {res.parameter[k]:.2f} (at x = "
+                f"{res.parameter[-1]:.2f}: {int(res.gaussian_sign[-1]):+d})",
             )
         )
         rows.append(
@@ -532,10 +567,17 @@ def _markdown(
         if quantities[0] == "pure_lce_length_L_over_L0" and "fig2fg_shapes.png" in names:
             lines += ["![shapes](figures/fig2fg_shapes.png)", ""]
         if quantities[0] == "lattice_gaussian_sign":
+            lines += [
+                "Views at the last ramp step before neighbouring filaments touch (the elastic "
+                "model without contact is valid up to there), then, where the ramp went on, "
+                "its end, where filaments pass through each other (physics notes §6).",
+                "",
+            ]
             for pattern in ("expanding", "contracting", "dome", "saddle"):
-                name = f"lattice_{pattern}_views.png"
-                if name in names:
-                    lines += [f"![{pattern}](figures/{name})", ""]
+                for suffix in ("", "_final"):
+                    name = f"lattice_{pattern}_views{suffix}.png"
+                    if name in names:
+                        lines += [f"![{pattern}{suffix}](figures/{name})", ""]
     lines += [
         "## Timings",
         "",
