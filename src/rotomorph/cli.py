@@ -130,6 +130,23 @@ def _print(text: str) -> None:
 # ----------------------------------------------------------------------------- commands
 
 
+def _check_materials(programs: list[Any]) -> None:
+    """Every material a program names must be known (raises MaterialError naming it)."""
+    from rotomorph.errors import MaterialError
+    from rotomorph.materials.material import get_material, known_materials
+
+    for i, program in enumerate(programs):
+        for role in ("active", "passive"):
+            name = getattr(program, f"{role}_material")
+            try:
+                get_material(name)
+            except MaterialError:
+                raise MaterialError(
+                    f"print program {i}: {role} material",
+                    f"unknown material {name!r}; known: {', '.join(known_materials())}",
+                ) from None
+
+
 def _cmd_validate(args: argparse.Namespace) -> int:
     from rotomorph.io.designfile import design_schema
 
@@ -141,6 +158,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         raise UsageError("validate: give DESIGN.toml (or --schema)")
     design = _load_design(args.design)
     programs = design.to_programs()
+    _check_materials(programs)
     parts = []
     if design.filaments:
         parts.append(f"{len(design.filaments)} filament(s)")
