@@ -33,12 +33,13 @@ from rotomorph.analysis.shape import (
     fit_helix,
     polyline_morphology,
 )
-from rotomorph.errors import ConvergenceError, InvalidParameterError, RotomorphError
+from rotomorph.errors import InvalidParameterError, RotomorphError
 from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.natural import FilamentModel, NaturalField, natural_field
 from rotomorph.materials.process import actuation_fraction
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
+from rotomorph.solve.continuation import continuation
 from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.static import StaticResult, solve_static
 
@@ -192,28 +193,6 @@ def _blend(a: NaturalField, b: NaturalField, w: float) -> NaturalField:
     )
 
 
-def _solve_step(
-    program: Any,
-    previous: NaturalField,
-    target: NaturalField,
-    initial: State,
-    options: NewtonOptions | None,
-    depth: int,
-) -> tuple[StaticResult, int]:
-    """Solve at ``target`` from ``initial``; halve the step on failure. Returns (result, iters)."""
-    try:
-        res = solve_static(rod_model(program, target), initial=initial, options=options)
-        return res, res.iterations
-    except ConvergenceError:
-        if depth <= 0:
-            raise
-        logger.info("step to x=%.4f failed; halving it", target.actuation)
-    mid = _blend(previous, target, 0.5)
-    first, n1 = _solve_step(program, previous, mid, initial, options, depth - 1)
-    second, n2 = _solve_step(program, mid, target, first.state, options, depth - 1)
-    return second, n1 + n2
-
-
 def _final_shape(points: FloatArray, state: State) -> tuple[HelixFit | None, Morphology]:
     m1, _ = state.material_directors()
     try:
@@ -290,17 +269,25 @@ def simulate_filament(
     positions[0] = printed
     if progress is not None:
         progress(1)
-    for k in range(1, s):
-        res, its = _solve_step(program, fields[k - 1], fields[k], state, options, max_refinements)
-        state = res.state
-        positions[k], energy[k], iterations[k], residual[k] = (
-            res.positions,
-            res.energy,
-            its,
-            res.residual,
-        )
-        if progress is not None:
+    iterations_at: dict[float, int] = {}
+
+    def solve(w: float, initial: State) -> StaticResult:
+        # w runs over the step index; a halved step blends its two end fields (the natural
+        # field is linear in the actuation, stiffness does not depend on it)
+        k = min(int(np.floor(w)), s - 2)
+        field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
+        res = solve_static(rod_model(program, field), initial=initial, options=options)
+        iterations_at[w] = iterations_at.get(w, 0) + res.iterations
+        if progress is not None and w == int(w):
             progress(1)
+        return res
+
+    path = continuation(solve, np.arange(1.0, s), state, start=0.0, max_halvings=max_refinements)
+    for k, step in enumerate(path.steps, start=1):
+        res = step.result
+        positions[k], energy[k], residual[k] = res.positions, res.energy, res.residual
+        iterations[k] = sum(n for w, n in iterations_at.items() if k - 1 < w <= k)
+    state = path.final.state
     ratio = np.array([end_to_end_ratio(p, printed) for p in positions])
     curvature = np.full((s, len(printed)), np.nan)
     for k in range(s):
