@@ -33,9 +33,13 @@ def free_helix(n: int) -> dict:
     fit = fit_helix(result.positions)
     k, t = 0.5, 0.3
     return {
-        "case": "free_helix", "n_nodes": n, "iterations": result.iterations,
-        "radius": fit.radius, "radius_exact": k / (k * k + t * t),
-        "pitch": abs(fit.pitch), "pitch_exact": 2 * np.pi * t / (k * k + t * t),
+        "case": "free_helix",
+        "n_nodes": n,
+        "iterations": result.iterations,
+        "radius": fit.radius,
+        "radius_exact": k / (k * k + t * t),
+        "pitch": abs(fit.pitch),
+        "pitch_exact": 2 * np.pi * t / (k * k + t * t),
     }
 
 
@@ -44,15 +48,24 @@ def drooping_cantilever(n: int) -> dict:
     radius, young, length = 0.3, 29.67, 20.0
     inertia = np.pi * radius**4 / 4
     s = np.linspace(0.0, length, n)
-    model = Model.chain(np.c_[s, 0 * s, 0 * s], bending_stiffness1=young * inertia,
-                        bending_stiffness2=young * inertia,
-                        twist_stiffness=young / 3 * 2 * inertia,
-                        axial_stiffness=young * np.pi * radius**2)
-    loads = Loads(forces=[(n - 1, (0.0, 0.0, -2e-4))],  # N
-                  gravity=Gravity(density=1.1, area=np.pi * radius**2))
+    model = Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=young * inertia,
+        bending_stiffness2=young * inertia,
+        twist_stiffness=young / 3 * 2 * inertia,
+        axial_stiffness=young * np.pi * radius**2,
+    )
+    loads = Loads(
+        forces=[(n - 1, (0.0, 0.0, -2e-4))],  # N
+        gravity=Gravity(density=1.1, area=np.pi * radius**2),
+    )
     result = solve_static(model, Supports.clamp_ends(n), loads)
-    return {"case": "cantilever", "n_nodes": n, "iterations": result.iterations,
-            "tip_deflection_mm": float(-result.positions[-1, 2])}
+    return {
+        "case": "cantilever",
+        "n_nodes": n,
+        "iterations": result.iterations,
+        "tip_deflection_mm": float(-result.positions[-1, 2]),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
