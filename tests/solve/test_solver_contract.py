@@ -167,3 +167,20 @@ def test_newton_escapes_a_saddle_to_a_minimum():
 
     res = minimize(FunctionObjective(f, g, h), np.array([1e-3, 0.5]))
     assert res.converged and abs(abs(res.x[0]) - 1) < 1e-8
+
+
+def test_line_search_failure_is_reported_not_looped():
+    # an objective whose gradient points uphill: every step fails the line search; the solver
+    # must raise the shift through its shifted path and give up with LINE_SEARCH_FAILED
+    def f(z):
+        return float(z @ z)
+
+    def g(z):
+        return -2 * z
+
+    def h(z):
+        return 2 * np.eye(len(z))
+
+    res = minimize(FunctionObjective(f, g, h), np.array([1.0, -2.0]))
+    assert res.status is Status.LINE_SEARCH_FAILED
+    assert res.iterations < 20

@@ -162,6 +162,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         floor = tau_min
         if res < opt.endgame:
             floor = max(floor, obj.shift_floor(g))
+        shift = floor
         if pure:
             n_fact += 1
             fac = factorize(H, floor * M)
@@ -196,6 +197,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 if tau > 1e12 * tau_unit:
                     status = Status.NOT_FINITE
                     return _result(x, status, it, n_fact, f, res, dec, history)
+            shift = tau
             if not convex and tau > opt.curvature_shift * tau_unit:
                 v = _negative_curvature_direction(fac, H, M, g, tau, opt.curvature_iterations)
                 if v is not None:
@@ -208,12 +210,14 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             obj.accept(x)
             f, g, H = obj.evaluate(x, True, True)
             res = float(_norm(w * g)) / fscale
-            history.append((f, res, 1.0, tau))
+            history.append((f, res, 1.0, shift))
             status = Status.CONVERGED
             return _result(x, status, it, n_fact, f, res, dec, history)
         alpha = min(1.0, obj.max_step(x, d))
         accepted = False
         for _ in range(opt.max_backtracks):
+            if alpha < 1e-10:  # a step this short changes nothing in floating point
+                break
             xt = obj.retract(x, d, alpha)
             ft = obj.evaluate(xt, False, False)[0]
             if np.isfinite(ft) and ft <= f + opt.armijo * alpha * slope:
@@ -225,11 +229,14 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             alpha = float(np.clip(a_q, 0.1 * alpha, 0.5 * alpha))
         if not accepted:
             if tau < 1e10 * tau_unit:
+                # retry through the shifted path with a larger shift (on the convex Hessian
+                # where the objective has one)
                 tau = max(100.0 * tau, 1e-6 * tau_unit)
                 first_try_ok = False
-                if convex and skip_exact == 0:
+                if skip_exact == 0:
                     skip_exact = 1
-                    H = obj.convex_hessian(x)
+                    if convex:
+                        H = obj.convex_hessian(x)
                 history.append((f, res, 0.0, tau))
                 continue
             status = Status.LINE_SEARCH_FAILED
@@ -238,9 +245,9 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         obj.accept(x)
         # exact Hessian (mode 1) unless the backoff asks for the convex one next (mode 2)
         f, g, H = obj.evaluate(x, True, 1 if (skip_exact == 0 or not convex) else 2)
-        history.append((f, float(_norm(w * g)) / fscale, alpha, tau))
+        history.append((f, float(_norm(w * g)) / fscale, alpha, shift))
         log.debug(
-            "newton %d: E=%.6e res=%.3e alpha=%.3g tau=%.3g", it, f, history[-1][1], alpha, tau
+            "newton %d: E=%.6e res=%.3e alpha=%.3g shift=%.3g", it, f, history[-1][1], alpha, shift
         )
     res = float(_norm(w * g)) / fscale
     return _result(x, status, it, n_fact, f, res, dec, history)
