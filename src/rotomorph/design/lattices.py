@@ -24,11 +24,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Literal, Union
+from typing import Literal, Union, cast
 
 import numpy as np
 
-from rotomorph._typing import FloatArray, IntArray
+from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.design.network import Network
 from rotomorph.design.path import Path
 from rotomorph.design.program import PrintProgram, active_side_angle
@@ -48,12 +48,12 @@ def _edge_list(n: int) -> IntArray:
     return np.array(ex + ey, dtype=np.int64)
 
 
-def _central(n: int, edges: IntArray, centre: str) -> np.ndarray:
+def _central(n: int, edges: IntArray, centre: str) -> BoolArray:
     i, j = np.divmod(edges, n)
     interior = (i > 0) & (i < n - 1) & (j > 0) & (j < n - 1)
     if centre == "central_cells":
         # both end nodes strictly inside: the 2x2 central cells for n = 5 (12 edges; notes Q12)
-        return interior.all(axis=1)
+        return cast(BoolArray, interior.all(axis=1))  # (E, 2) -> (E,): an array
     if centre == "interior":
         # every edge not on the perimeter (24 of 40 for n = 5)
         along_x = j[:, 0] == j[:, 1]
@@ -77,6 +77,7 @@ def _modes(pattern: Pattern, n: int, edges: IntArray, centre: str) -> tuple[str,
             "pattern",
             f"must be one of {PATTERNS}, a list of {m} modes or a per-edge map; got {pattern!r}",
         )
+    seq: Sequence[str]
     if isinstance(pattern, Mapping):
         index = {(int(a), int(b)): e for e, (a, b) in enumerate(edges)}
         out: list[str | None] = [None] * m
@@ -94,8 +95,10 @@ def _modes(pattern: Pattern, n: int, edges: IntArray, centre: str) -> tuple[str,
             raise InvalidDesignError(
                 "pattern", f"per-edge map misses edge {out.index(None)}; give all {m} edges"
             )
-        pattern = out  # type: ignore[assignment]
-    modes = tuple(pattern)  # type: ignore[arg-type]
+        seq = cast(list[str], out)  # no None left (checked above)
+    else:
+        seq = pattern
+    modes = tuple(seq)
     if len(modes) != m:
         raise InvalidDesignError(
             "pattern", f"needs one mode per lattice edge ({m}); got {len(modes)}"

@@ -38,7 +38,7 @@ class Network:
 
     nodes: FloatArray
     edges: IntArray
-    branch: BoolArray = field(default=None)  # type: ignore[assignment]
+    branch: BoolArray = field(default=None)  # type: ignore[arg-type]  # set by __post_init__
 
     def __post_init__(self) -> None:
         nodes = np.array(self.nodes, dtype=float)

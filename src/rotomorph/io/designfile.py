@@ -39,7 +39,7 @@ import hashlib
 import json
 import math
 from pathlib import Path as FilePath
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
 import numpy as np
 import tomli_w
@@ -50,6 +50,9 @@ from rotomorph.design.path import Arc, Line, Path, Polyline, Sinusoid, chain_seg
 from rotomorph.design.program import PrintProgram, active_side_angle
 from rotomorph.errors import InvalidDesignError
 from rotomorph.io.atomic import atomic_write_text
+
+if TYPE_CHECKING:
+    from pydantic_core import ErrorDetails
 
 try:  # Python >= 3.11
     import tomllib
@@ -65,7 +68,7 @@ __all__ = [
     "save_design",
 ]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION: Final = 1
 _UNITS = {
     "speed": "mm/s",
     "length": "mm",
@@ -328,7 +331,7 @@ class Design(_Model):
         return hashlib.sha256(blob.encode()).hexdigest()
 
 
-def _format_error(err: dict[str, Any]) -> tuple[str, str]:
+def _format_error(err: ErrorDetails) -> tuple[str, str]:
     loc: list[str] = []
     for part in err["loc"]:
         if isinstance(part, int):

@@ -59,9 +59,20 @@ PAPER_FINAL_X = 0.75
 class Actuation(Protocol):
     """What :func:`rotomorph.lattice.heating.heat_lattice` needs from an actuation mode."""
 
-    name: str
-    start: float
-    end: float
+    @property
+    def name(self) -> str:
+        """Name of the actuation mode."""
+        ...
+
+    @property
+    def start(self) -> float:
+        """First value of the ramp parameter (x, or temperature in °C for thermal modes)."""
+        ...
+
+    @property
+    def end(self) -> float:
+        """Last value of the ramp parameter."""
+        ...
 
     def natural(self, lm: LatticeModel, parameter: float) -> Model:
         """The rod model at ramp ``parameter``."""

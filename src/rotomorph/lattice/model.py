@@ -127,7 +127,7 @@ def _stiffness(
     raise InvalidParameterError("stiffness", f"must be 'paper' or 'janus'; got {stiffness!r}")
 
 
-def stencil_sides(segment_side: FloatArray, model: Model) -> FloatArray:
+def stencil_sides(segment_side: IntArray | FloatArray, model: Model) -> FloatArray:
     """Active side (+1 left, −1 right, 0 none) of every stencil ``(S,)`` (module docstring).
 
     Parameters
@@ -147,7 +147,9 @@ def stencil_sides(segment_side: FloatArray, model: Model) -> FloatArray:
     return np.where(st.junction, 0.0, out)
 
 
-def active_side_basis(segment_side: FloatArray, model: Model) -> tuple[FloatArray, FloatArray]:
+def active_side_basis(
+    segment_side: IntArray | FloatArray, model: Model
+) -> tuple[FloatArray, FloatArray]:
     """Per-stencil ``(Δκ1, Δκ2)`` of a unit pointwise curvature toward the active side.
 
     Computed in the printed configuration with the model's directors (module docstring);

@@ -189,7 +189,10 @@ class ActuationStrainModel(Protocol):
     and a ``measure`` field (``"hencky"`` or ``"engineering"``).
     """
 
-    measure: Measure
+    @property
+    def measure(self) -> Measure:
+        """``"hencky"`` or ``"engineering"``: the measure of the returned strains."""
+        ...
 
     def active_strains(self, speed: float | FloatArray) -> tuple[FloatArray, FloatArray]:
         """(ε∥ along the director, ε⊥ across it) at full actuation, for print speed v (mm/s)."""

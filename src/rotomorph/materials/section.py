@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -101,7 +102,8 @@ class AxialSection:
         eps = evaluate(eigenstrain, self.points, self.active)
         lever = (self.modulus * self.weights)[:, None] * (self.points - self.centroid)
         moment = eps @ lever
-        return -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0]
+        # float64 inputs give a float64 solution (the stubs only promise "floating")
+        return cast(FloatArray, -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0])
 
 
 def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> AxialSection:

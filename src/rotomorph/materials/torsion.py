@@ -25,7 +25,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.linalg import spsolve
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.mesh import SectionMesh
 from rotomorph.materials.section import Field, evaluate
@@ -43,7 +43,7 @@ class TorsionSection:
     warping: FloatArray
     twist_weights: FloatArray
     points: FloatArray
-    active: FloatArray
+    active: BoolArray
 
     def natural_twist(self, eigenshear: Field | FloatArray) -> FloatArray:
         """Natural twist τ̄ (1/mm) of an eigen-shear field (values ``(..., Q, 2)`` or callable).

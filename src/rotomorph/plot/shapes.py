@@ -7,9 +7,10 @@ ignoring NaN; a segment with no finite value is drawn in grey.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Colormap, Normalize
 from matplotlib.figure import Figure
@@ -18,6 +19,9 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.plot.figure import new_figure
+
+if TYPE_CHECKING:
+    from mpl_toolkits.mplot3d.axes3d import Axes3D
 
 __all__ = [
     "plot_lattice_views",
@@ -100,7 +104,7 @@ def _style(collection, values, edges, n_nodes, cmap, vmin, vmax, color):
     return collection
 
 
-def set_equal_3d(ax: Axes, positions: FloatArray, *, min_fraction: float = 0.02) -> None:
+def set_equal_3d(ax: Axes3D, positions: FloatArray, *, min_fraction: float = 0.02) -> None:
     """Give a 3-D axes equal scale on x, y, z around ``positions`` (mm), with a tight box.
 
     Axes with (nearly) no extent get ``min_fraction`` of the largest extent so that flat
@@ -196,7 +200,8 @@ def plot_lattice_views(
     top, side = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.0, 1.4]})
     mappable = None
     for ax, (i, j), name in ((top, (0, 1), "top"), (side, (0, 2), "side")):
-        coll = LineCollection(pos[e][:, :, [i, j]], linewidths=linewidth)
+        # an (E, 2, 2) array is a valid segment list; the stubs only accept a Sequence
+        coll = LineCollection(pos[e][:, :, [i, j]], linewidths=linewidth)  # type: ignore[arg-type]
         mappable = _style(coll, values, e, len(pos), cmap, vmin, vmax, color)
         ax.add_collection(coll)
         ax.autoscale_view()

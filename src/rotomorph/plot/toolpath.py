@@ -49,8 +49,11 @@ def plot_toolpath(programs: Sequence[PrintProgram], *, glyphs: int = 40) -> Figu
         for prog in (p for p in programs if p.layer == layer):
             pts = prog.points[:, :2]
             alpha = np.mod(prog.interface_angle + np.pi, 2 * np.pi) - np.pi
+            # an (N, 2, 2) array is a valid segment list; the stubs only accept a Sequence
             lc = LineCollection(
-                np.stack([pts[:-1], pts[1:]], axis=1), cmap="twilight", linewidths=2.0
+                np.stack([pts[:-1], pts[1:]], axis=1),  # type: ignore[arg-type]
+                cmap="twilight",
+                linewidths=2.0,
             )
             lc.set_array(alpha)
             lc.set_clim(-np.pi, np.pi)

@@ -9,6 +9,7 @@ are arrays fixed at construction; transforms return new models (:meth:`Model.wit
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 
@@ -161,21 +162,26 @@ class Model:
         st, x = self.stencils, self.network.nodes
         e = x[st.nodes[:, 1]] - x[st.nodes[:, 0]]
         f = x[st.nodes[:, 2]] - x[st.nodes[:, 1]]
-        return pair_strains(e, f, self.directors[st.edge_e], self.directors[st.edge_f])
+        d = cast(FloatArray, self.directors)  # set to an array by __post_init__
+        return pair_strains(e, f, d[st.edge_e], d[st.edge_f])
 
     @property
     def voronoi_length(self) -> FloatArray:
         """Per-stencil Voronoi length of rest lengths ``(S,)`` (mm)."""
-        r = self.rest_length
+        r = cast(FloatArray, self.rest_length)  # set to an array by __post_init__
         return 0.5 * (r[self.stencils.edge_e] + r[self.stencils.edge_f])
 
     @property
     def stencil_stiffness(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Per-stencil ``(B1, B2, C)`` (N mm²): edge means; isotropic at junctions."""
         st = self.stencils
-        b1 = 0.5 * (self.bending_stiffness1[st.edge_e] + self.bending_stiffness1[st.edge_f])
-        b2 = 0.5 * (self.bending_stiffness2[st.edge_e] + self.bending_stiffness2[st.edge_f])
-        c = 0.5 * (self.twist_stiffness[st.edge_e] + self.twist_stiffness[st.edge_f])
+        # per-edge arrays once __post_init__ has run
+        s1 = cast(FloatArray, self.bending_stiffness1)
+        s2 = cast(FloatArray, self.bending_stiffness2)
+        sc = cast(FloatArray, self.twist_stiffness)
+        b1 = 0.5 * (s1[st.edge_e] + s1[st.edge_f])
+        b2 = 0.5 * (s2[st.edge_e] + s2[st.edge_f])
+        c = 0.5 * (sc[st.edge_e] + sc[st.edge_f])
         iso = 0.5 * (b1 + b2)
         b1 = np.where(st.junction, iso, b1)
         b2 = np.where(st.junction, iso, b2)
@@ -184,7 +190,11 @@ class Model:
     def integrated_natural(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Natural ``(kappa1, kappa2, tau)`` per stencil, integrated (dimensionless)."""
         v = self.voronoi_length
-        return self.natural_curvature1 * v, self.natural_curvature2 * v, self.natural_twist * v
+        # the natural fields are arrays once __post_init__ has run
+        k1 = cast(FloatArray, self.natural_curvature1)
+        k2 = cast(FloatArray, self.natural_curvature2)
+        tw = cast(FloatArray, self.natural_twist)
+        return k1 * v, k2 * v, tw * v
 
     def reference_strains(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Pointwise curvatures and twist of the reference configuration (1/mm), per stencil."""

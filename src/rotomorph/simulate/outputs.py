@@ -110,6 +110,8 @@ def plot_run(
     values = None if name is None else results.fields[name]
     pos, edges = results.positions, results.edges
     paths = []
+    vmin: float | None
+    vmax: float | None
     if values is not None:
         finite = values[np.isfinite(values)]
         lim = float(np.max(np.abs(finite))) if finite.size else 1.0

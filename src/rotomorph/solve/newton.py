@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Literal, Protocol, overload
 
 import numpy as np
 
@@ -31,6 +31,17 @@ log = logging.getLogger(__name__)
 
 class Objective(Protocol):
     """What :func:`minimize` needs from a problem."""
+
+    # asked for (need_grad=True), the gradient is never None
+    @overload
+    def evaluate(
+        self, x: FloatArray, need_grad: Literal[True], need_hess: int
+    ) -> tuple[float, FloatArray, Any]: ...
+
+    @overload
+    def evaluate(
+        self, x: FloatArray, need_grad: bool, need_hess: int
+    ) -> tuple[float, FloatArray | None, Any]: ...
 
     def evaluate(
         self, x: FloatArray, need_grad: bool, need_hess: int

@@ -8,6 +8,7 @@ Positions and twist angles of fixed DOFs keep their base values.
 from __future__ import annotations
 
 import weakref
+from typing import cast
 
 import numpy as np
 import scipy.sparse as sp
@@ -79,7 +80,11 @@ class RodObjective:
         self._st_signs = np.ascontiguousarray(np.stack([st.sign_e, st.sign_f], axis=1))
         self._st_params = np.ascontiguousarray(np.stack([b1, b2, c, self._vor, k1, k2, tw], 1))
         self._ed_params = np.ascontiguousarray(
-            np.stack([model.axial_stiffness, model.rest_length], axis=1)
+            # Model.__post_init__ turns every per-edge field into an array
+            np.stack(
+                [cast(FloatArray, model.axial_stiffness), cast(FloatArray, model.rest_length)],
+                axis=1,
+            )
         )
         self._external = self._external_forces(loads)
         self._has_forces = bool(np.any(self._external))
@@ -117,7 +122,7 @@ class RodObjective:
             vec = _vector("Loads.forces", force)
             f[lay.pos[node] + np.arange(3)] += vec
         if loads.gravity is not None:
-            w = loads.gravity.line_weight(net.n_edges) * self.model.rest_length
+            w = loads.gravity.line_weight(net.n_edges) * cast(FloatArray, self.model.rest_length)
             d = np.asarray(loads.gravity.direction, float)
             d = d / np.linalg.norm(d)
             for end in (0, 1):
@@ -152,9 +157,10 @@ class RodObjective:
 
     def _setup_scales(self, loads: Loads) -> None:
         net = self.model.network
-        ext = np.ptp(net.nodes, axis=0).max() or float(self.model.rest_length.sum())
-        self.length_scale = float(max(ext, self.model.rest_length.max()))
-        lmean = float(self.model.rest_length.mean())
+        rest = cast(FloatArray, self.model.rest_length)  # an array after Model.__post_init__
+        ext = np.ptp(net.nodes, axis=0).max() or float(rest.sum())
+        self.length_scale = float(max(ext, rest.max()))
+        lmean = float(rest.mean())
         b1, b2, c = self._stiff
         stiff = np.maximum(np.maximum(b1, b2), c)
         k1, k2, tw = self._natural
@@ -171,13 +177,13 @@ class RodObjective:
         )
         lay = self.model.layout
         m = np.zeros(lay.count)
-        half = 0.5 * self.model.rest_length
+        half = 0.5 * rest
         for end in (0, 1):
             for k in range(3):
                 np.add.at(m, lay.pos[net.edges[:, end]] + k, half)
         # a twist angle is weighted like the rotation of its edge (length^3), so that the
         # shift damps twisting and bending rotations alike at every mesh size
-        m[lay.theta] = self.model.rest_length**3
+        m[lay.theta] = rest**3
         self._metric = m[self.free]
         self._node_metric = m[lay.pos]
         self._theta_metric = m[lay.theta]
@@ -190,7 +196,7 @@ class RodObjective:
     def set_base(self, state: State) -> None:
         """Make ``state`` the base of later evaluations."""
         self.base = state
-        self._last = None
+        self._last: tuple[FloatArray, FloatArray, FloatArray] | None = None
         u = np.empty(self.model.layout.count)
         u[self._pos_index] = state.positions.ravel()
         u[self._theta_index] = state.theta

@@ -79,6 +79,8 @@ class EdgeRotationRetraction:
         fixed[fixed_nodes] = True
         self.anchor_first = not fixed.any()
         is_tree = len(edges) == n_nodes - 1 and fixed.sum() <= 1
+        # (root, order, parent, parent_edge, sign) of a spanning tree, or None
+        self._tree: tuple[int, IntArray, IntArray, IntArray, FloatArray] | None
         if is_tree:
             root = int(np.flatnonzero(fixed)[0]) if fixed.any() else 0
             tree = _bfs_tree(self.edges, n_nodes, root)
