@@ -26,8 +26,8 @@ from typing import Any
 
 from rotomorph.errors import RotomorphError
 from rotomorph.io.designfile import Filament
-from rotomorph.materials import EmpiricalThreshold, FilamentModel, calibrate, load_table
-from rotomorph.materials.calibrate import filament_shapes
+from rotomorph.materials import FilamentModel, load_table
+from rotomorph.materials.calibrate import filament_shapes, paper_calibration
 from rotomorph.simulate.filament import simulate_filament
 
 
@@ -50,14 +50,7 @@ def rod_solver(model: FilamentModel, omega_star: float, fraction: float) -> tupl
 
 def calibrated_models() -> dict[str, tuple[FilamentModel, Any]]:
     """The two calibrated models and their calibration results, by name."""
-    curv = load_table("janus_curvature")
-    wt = calibrate(curv, ["modulus_ratio"], FilamentModel(), use=[curv.near(3.0)])
-    emp = calibrate(
-        curv,
-        ["strain_model.gain", "strain_model.threshold"],
-        FilamentModel(strain_model=EmpiricalThreshold(), modulus_ratio=wt.model.modulus_ratio),
-        use=[curv.near(0.25), curv.near(3.0)],
-    )
+    wt, emp = paper_calibration()
     return {"warner_terentjev": (wt.model, wt), "empirical_threshold": (emp.model, emp)}
 
 

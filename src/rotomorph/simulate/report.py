@@ -38,8 +38,8 @@ import rotomorph
 from rotomorph.errors import RotomorphError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import write_summary
-from rotomorph.materials import EmpiricalThreshold, FilamentModel, calibrate, load_table
-from rotomorph.materials.calibrate import filament_shapes, janus_curvature
+from rotomorph.materials import FilamentModel, load_table
+from rotomorph.materials.calibrate import filament_shapes, janus_curvature, paper_calibration
 
 __all__ = ["PaperReport", "calibrated_model", "paper_report"]
 
@@ -80,14 +80,7 @@ def calibrated_model() -> tuple[FilamentModel, dict[str, float]]:
     E_a/E_p is fitted to K_J(v = 3 mm/s) with Warner–Terentjev strains, then the empirical
     threshold law's gain and threshold to v = 0.25 and 3 mm/s with that ratio held.
     """
-    curv = load_table("janus_curvature")
-    wt = calibrate(curv, ["modulus_ratio"], FilamentModel(), use=[curv.near(3.0)])
-    emp = calibrate(
-        curv,
-        ["strain_model.gain", "strain_model.threshold"],
-        FilamentModel(strain_model=EmpiricalThreshold(), modulus_ratio=wt.model.modulus_ratio),
-        use=[curv.near(0.25), curv.near(3.0)],
-    )
+    _, emp = paper_calibration()
     m = emp.model
     params = {
         "modulus_ratio": float(m.modulus_ratio),  # type: ignore[arg-type]
