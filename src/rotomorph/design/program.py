@@ -34,6 +34,7 @@ side of the path (the inner side of a left turn).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Union
@@ -220,30 +221,12 @@ class PrintProgram:
         pts = self.points.copy()
         if z is not None:
             pts[:, 2] = z
-        return PrintProgram(
-            pts,
-            self.speed,
-            self.nozzle_angle,
-            self.radius,
-            self.active_fraction,
-            self.active_material,
-            self.passive_material,
-            layer,
-        )
+        return dataclasses.replace(self, points=pts, layer=layer)
 
     def translated(self, offset: FloatArray | tuple[float, float, float]) -> PrintProgram:
         """The same program moved by ``offset`` (mm, length 3); angles are unchanged."""
         pts = self.points + np.asarray(offset, dtype=float).reshape(3)
-        return PrintProgram(
-            pts,
-            self.speed,
-            self.nozzle_angle,
-            self.radius,
-            self.active_fraction,
-            self.active_material,
-            self.passive_material,
-            self.layer,
-        )
+        return dataclasses.replace(self, points=pts)
 
     # ----------------------------------------------------------------- constructors
     @classmethod

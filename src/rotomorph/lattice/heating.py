@@ -216,6 +216,12 @@ class HeatingResult:
         """Newton iterations over the whole ramp."""
         return int(self.iterations.sum())
 
+    def last_contact_free(self, threshold: float = 1.0) -> int:
+        """Index of the last ramp step before filaments come closer than ``threshold``
+        diameters (the last step if they never do)."""
+        hit = np.flatnonzero(self.min_clearance < threshold)
+        return int(max(hit[0] - 1, 0)) if len(hit) else len(self.parameter) - 1
+
     def first_overlap(self, threshold: float = 1.0) -> float | None:
         """First ramp parameter at which filaments come closer than ``threshold`` diameters."""
         hit = np.flatnonzero(self.min_clearance < threshold)

@@ -348,12 +348,6 @@ def _heat(pattern: str, quick: bool, steps: int) -> tuple[Any, Any, str]:
         return lattice, None, f"lattice solver failed: {' '.join(str(err).split())[:160]}"
 
 
-def _contact_free(res: Any) -> int:
-    """Index of the last ramp step before filaments come within one diameter of each other."""
-    hit = np.flatnonzero(np.asarray(res.min_clearance) < 1.0)
-    return int(max(hit[0] - 1, 0)) if len(hit) else len(res.parameter) - 1
-
-
 def _lattice_section(
     figs: Path, *, quick: bool, steps: int, tick: Callable[[], None]
 ) -> tuple[list[dict], list[Path]]:
@@ -392,7 +386,7 @@ def _lattice_section(
             )
         )
         if res is not None and pattern == "contracting":
-            k = _contact_free(res)
+            k = res.last_contact_free()
             rows.append(
                 _row(
                     "lattice_area_ratio",
@@ -409,7 +403,7 @@ def _lattice_section(
             )
         if res is not None:
             ax.plot(res.parameter, res.area_ratio, "o-", ms=3, label=f"{pattern} (model)")
-            k = _contact_free(res)
+            k = res.last_contact_free()
             if k < len(res.parameter) - 1:
                 ax.axvline(res.parameter[k], color="0.6", ls=":", lw=1)
         ax.errorbar([0.75], [measured], yerr=[spread], fmt="s", capsize=3,
@@ -426,7 +420,7 @@ def _lattice_section(
         lattice, res, _ = results[pattern]
         if res is None:
             continue
-        k_free, k_end = _contact_free(res), len(res.parameter) - 1
+        k_free, k_end = res.last_contact_free(), len(res.parameter) - 1
         for k, suffix in ((k_free, ""), (k_end, "_final")):
             if suffix and k == k_free:
                 continue
@@ -449,7 +443,7 @@ def _lattice_section(
         axes, (("dome", 1, "4C"), ("saddle", -1, "4F")), strict=True
     ):
         lattice, res, why = results[pattern]
-        k = 0 if res is None else _contact_free(res)
+        k = 0 if res is None else res.last_contact_free()
         rows.append(
             _row(
                 "lattice_gaussian_sign",
