@@ -1,5 +1,5 @@
-"""Imports flow one way: design -> materials -> rod -> solve -> analysis -> lattice -> io ->
-plot -> simulate -> cli (DESIGN.md §1); errors, type aliases and geometry sit below all."""
+"""Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis -> lattice ->
+io -> plot -> simulate -> inverse | sweep -> cli; errors, type aliases and geometry sit below all."""
 
 from __future__ import annotations
 
@@ -14,12 +14,14 @@ LAYERS = [
     {"design"},
     {"materials"},
     {"rod"},
+    {"contact"},
     {"solve"},
     {"analysis"},
     {"lattice"},
     {"io"},
     {"plot"},
     {"simulate"},
+    {"inverse", "sweep"},
     {"cli", "__main__"},
 ]
 RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}
