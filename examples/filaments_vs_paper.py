@@ -1,4 +1,7 @@
-"""Single filaments: model vs the paper's measured values, one JSON object per line.
+"""Single filaments against the paper
+==================================
+
+Single filaments: model vs the paper's measured values, one JSON object per line.
 
 Calibration (honest about what is fitted):
 

@@ -1,4 +1,7 @@
-"""Lattices vs the paper (Fig. 3/4): one JSON line per quantity.
+"""Lattices against the paper
+==========================
+
+Lattices vs the paper (Fig. 3/4): one JSON line per quantity.
 
 Calibration (honest, one number): the sinusoid amplitude A/l is chosen so that a free expanding
 edge reaches the paper's end-to-end ratio 1.37 at the end of the ramp (reading (b), x = 0.75,

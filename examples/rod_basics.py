@@ -1,4 +1,7 @@
-"""Rod basics: build a filament, give it a natural curvature-twist field, support it, load it,
+"""Rod basics
+==========
+
+Rod basics: build a filament, give it a natural curvature-twist field, support it, load it,
 solve, and check the answer against the exact helix.
 
 Run: ``python examples/rod_basics.py [--nodes N]``. Prints one JSON object per line.

@@ -1,5 +1,6 @@
-"""Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis -> lattice ->
-io -> plot -> simulate -> inverse | sweep -> cli; errors, type aliases and geometry sit below all."""
+"""Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis ->
+lattice -> io -> plot -> simulate -> inverse | sweep -> cli; errors, type aliases and geometry
+sit below all."""
 
 from __future__ import annotations
 

@@ -2,19 +2,19 @@ r"""Print programs: what the printer does along ONE filament (path, speed, nozzl
 
 Symbols (paper, "Rotational multimaterial 3D printing"; physics notes 1.1):
 
-==================  ==========================================================================
-``speed`` v         print (translation) speed at each vertex (mm/s); the move that *leaves*
-                    vertex i runs at ``speed[i]`` (the last value repeats the last move's)
-``nozzle_angle``    :math:`\alpha_n`, lab angle of the interface normal n toward the active
-                    channel, counter-clockwise from +x seen from above (rad), cumulative
-                    (unwrapped): this is what the rotary axis commands
-``rotation`` ω      :math:`v\,d\alpha_n/ds` (rad/s) at each vertex
-``interface_angle`` :math:`\alpha`, the angle of n in the filament cross-section, measured from
-                    :math:`d_1` (= :func:`rotomorph.geometry.space_parallel_directors`, i.e.
-                    :math:`+\hat z` for a path in the xy-plane) toward :math:`d_2 = t\times d_1`
-``ω*``              rotation number :math:`R\omega/v` (paper eq. for ω*, notes Q1: R = filament
-                    radius)
-==================  ==========================================================================
+===================  =========================================================================
+``speed`` v          print (translation) speed at each vertex (mm/s); the move that *leaves*
+                     vertex i runs at ``speed[i]`` (the last value repeats the last move's)
+``nozzle_angle``     :math:`\alpha_n`, lab angle of the interface normal n toward the active
+                     channel, counter-clockwise from +x seen from above (rad), cumulative
+                     (unwrapped): this is what the rotary axis commands
+``rotation`` ω       :math:`v\,d\alpha_n/ds` (rad/s) at each vertex
+``interface_angle``  :math:`\alpha`, the angle of n in the filament cross-section, measured from
+                     :math:`d_1` (= :func:`rotomorph.geometry.space_parallel_directors`, i.e.
+                     :math:`+\hat z` for a path in the xy-plane) toward :math:`d_2 = t\times d_1`
+``ω*``               rotation number :math:`R\omega/v` (paper eq. for ω*, notes Q1: R = filament
+                     radius)
+===================  =========================================================================
 
 Interface angle convention (notes 1.1, [DERIVED + ASSUMPTION]): the extrudate leaves the nozzle
 flowing along :math:`-\hat z` and is laid down along the path tangent t by the rigid rotation

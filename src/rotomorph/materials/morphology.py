@@ -5,9 +5,9 @@ k̄ = (K, 0, τ) with m1 along the curvature direction gives a helix (physics no
 kinetic analogy, e.g. Love, *A Treatise on the Mathematical Theory of Elasticity*, §270):
 
 * radius ρ = K/(K² + τ²), pitch P = 2πτ/(K² + τ²) (τ > 0: right-handed),
-* end-to-end length per arc length L/L0 = |τ|/√(K² + τ²), times the axial stretch (1 + ε_c)
+* end-to-end length per arc length L/L0 = abs(τ)/√(K² + τ²), times the axial stretch (1 + ε_c)
   (engineering) or exp(ε_c) (Hencky) when the centre line contracts,
-* morphology parameter Λ = K/|τ|: Λ ≥ 1 tight coils (L/L0 ≈ 1/Λ), Λ < 1 helices that open into
+* morphology parameter Λ = K/abs(τ): Λ ≥ 1 tight coils (L/L0 ≈ 1/Λ), Λ < 1 helices that open into
   nearly straight twisted filaments (L/L0 ≈ 1 − Λ²/2).
 """
 
@@ -21,7 +21,7 @@ from rotomorph.errors import InvalidParameterError
 
 Label = Literal["coil", "helix", "twisted rod", "straight"]
 
-#: Λ = K/|τ| at and above which a shape is called a coil (L/L0 ≤ 1/√2).
+#: Λ = K/abs(τ) at and above which a shape is called a coil (L/L0 ≤ 1/√2).
 COIL_THRESHOLD = 1.0
 #: Λ below which the curvature is treated as numerical noise (quadrature round-off of a symmetric
 #: section): the shape is a twisted rod, L/L0 = stretch to 1e-12.
@@ -41,7 +41,7 @@ class HelixShape:
     end_to_end_ratio
         L/L0 (dimensionless), including the axial stretch.
     morphology_parameter
-        Λ = K/|τ| (``inf`` when τ = 0).
+        Λ = K/abs(τ) (``inf`` when τ = 0).
     label
         ``"coil"`` (Λ ≥ 1), ``"helix"`` (:data:`TWISTED_ROD_THRESHOLD` ≤ Λ < 1),
         ``"twisted rod"`` (K ≈ 0: Λ below that threshold or K < ``tol``, τ ≠ 0) or

@@ -1,7 +1,7 @@
 r"""Saint-Venant torsion with warping, and natural twist from an eigen-shear field (P1 FEM).
 
 For a section with shear modulus G(x) (MPa) and an in-plane engineering eigen-shear field
-γ*(x) = (2ε*_13, 2ε*_23) (dimensionless), the twist τ (1/mm) and warping w(x) (mm²·τ) minimise
+γ*(x) = (2ε*_13, 2ε*_23) (dimensionless), the twist τ (1/mm) and warping w(x) (mm²·τ) minimise::
 
     ½ ∫ G |τ p + ∇w − γ*|² dA,        p(x) = (−x2, x1)
 
@@ -10,7 +10,7 @@ with an eigenstrain added as in physics notes 1.4). Eliminating w (P1 elements, 
 pinned; the result does not depend on the origin of p):
 
 * K z = b with K_ab = ∫G ∇φ_a·∇φ_b, b_a = ∫G p·∇φ_a,
-* torsional stiffness C = ∫G |p − ∇z|² dA (N·mm²),
+* torsional stiffness C = ∫G ‖p − ∇z‖² dA (N·mm²),
 * natural twist τ̄ = ∫G (p − ∇z)·γ* dA / C, a linear functional of γ* (``twist_weights``).
 
 Checks (tests): homogeneous disk C = GπR⁴/2; semicircle C = (π/2 − 4/π) G R⁴ (Saint-Venant);
