@@ -8,8 +8,8 @@ Commands::
     rotomorph plot RESULT.h5 -o DIR           figures and GIF from a results file
     rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
 
-Exit codes: 0 success; 1 the computation failed (solver did not converge, machine limits);
-2 bad input (command line, design file, missing file, existing output folder).
+Exit codes: 0 success; 1 the computation failed (solver did not converge);
+2 bad input (command line, design file, machine limits, missing file, existing output folder).
 Errors print one line on stderr: ``rotomorph: error: <field>: <what is wrong and the fix>``.
 
 Folders (``simulate``, ``plot``, ``paper``) are written into a temporary sibling folder and
@@ -132,19 +132,9 @@ def _print(text: str) -> None:
 
 def _check_materials(programs: list[Any]) -> None:
     """Every material a program names must be known (raises MaterialError naming it)."""
-    from rotomorph.errors import MaterialError
-    from rotomorph.materials.material import get_material, known_materials
+    from rotomorph.io.gcode import check_materials
 
-    for i, program in enumerate(programs):
-        for role in ("active", "passive"):
-            name = getattr(program, f"{role}_material")
-            try:
-                get_material(name)
-            except MaterialError:
-                raise MaterialError(
-                    f"print program {i}: {role} material",
-                    f"unknown material {name!r}; known: {', '.join(known_materials())}",
-                ) from None
+    check_materials(programs)
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
@@ -194,7 +184,14 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
             machine = replace(machine, dialect=args.dialect)
     else:
         machine = MachineProfile(dialect=args.dialect or "aerotech")
+        sys.stderr.write(
+            "rotomorph: note: no --machine given; using the built-in default machine "
+            f"'{machine.name}' (envelope {list(machine.envelope_max)} mm, max feed "
+            f"{machine.max_feed:g} mm/s, max rotation {machine.max_rotation:g} rad/s); "
+            "stated in the header\n"
+        )
     programs = design.to_programs()
+    _check_materials(programs)
     write_gcode(programs, out, machine, **design.gcode_options(), layer_cure_s=args.cure)
     _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
     return EXIT_OK
@@ -362,7 +359,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ConvergenceError as err:
         return _fail(f"solver: {err}", EXIT_FAILED)
     except MachineLimitError as err:
-        return _fail(f"machine limits: {err}", EXIT_FAILED)
+        return _fail(f"machine limits: {err}", EXIT_USAGE)
     except RotomorphError as err:
         return _fail(str(err), EXIT_FAILED)
     except OSError as err:

@@ -89,8 +89,9 @@ def test_gcode_machine_profile_and_limits(tmp_path, capsys):
     )
     out = tmp_path / "part.gcode"
     code = main(["gcode", str(DESIGNS[0]), "-o", str(out), "--machine", str(machine)])
-    assert code == EXIT_FAILED
-    assert "machine limits" in _one_line_error(capsys)
+    assert code == EXIT_USAGE
+    err = _one_line_error(capsys)
+    assert "machine limits" in err and "machine profile key 'envelope_max'" in err
     assert not out.exists() and _leftovers(tmp_path) == []
 
 

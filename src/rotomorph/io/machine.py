@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import string
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path as FilePath
 from typing import Any
 
@@ -30,13 +30,43 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-__all__ = ["DIALECTS", "MachineProfile", "load_machine_profile"]
+__all__ = ["DIALECTS", "MachineProfile", "check_line", "load_machine_profile"]
 
 DIALECTS = ("aerotech", "rs274", "marlin")
+BUILTIN = "built-in default"
 
 
 def _bad(field: str, message: str) -> InvalidParameterError:
-    return InvalidParameterError(f"MachineProfile.{field}", message)
+    """An error naming the key of the machine-profile file (``[machine]`` table)."""
+    return InvalidParameterError(f"machine profile key '{field}'", message)
+
+
+def check_line(field: str, text: object, *, token: bool = False) -> str:
+    """``text`` if it is one line of printable ASCII, else raise naming ``field``.
+
+    Everything that a design or a machine profile contributes to a G-code program (names,
+    templates, comments) passes through here, so no newline, carriage return, NUL or other
+    control character can start a new block in the program.
+
+    Parameters
+    ----------
+    field
+        Name of the setting, for the message.
+    text
+        The value.
+    token
+        Also refuse spaces (a single word, e.g. a material name).
+    """
+    if not isinstance(text, str):
+        raise InvalidParameterError(field, f"must be a string; got {type(text).__name__}")
+    low = 33 if token else 32
+    bad = [c for c in text if not (low <= ord(c) < 127)]
+    if bad:
+        what = "printable ASCII without spaces" if token else "one line of printable ASCII"
+        raise InvalidParameterError(
+            field, f"must be {what} (no newline or control character); got {text!r}"
+        )
+    return text
 
 
 @dataclass(frozen=True)
@@ -76,6 +106,14 @@ class MachineProfile:
         ``psi`` is allowed, e.g. ``{psi:.3f}``); map it to your controller's macro.
     uv_on_template, uv_off_template
         Optional lines around the per-layer UV-cure dwell (empty: dwell only).
+    min_feed
+        Lowest print feed (mm/s) the controller executes faithfully; slower moves are refused.
+    source
+        Where the profile came from: the file name, or ``"built-in default"`` (stated in the
+        G-code header). Not a file key.
+
+    Every text value must be one line of printable ASCII (:func:`check_line`); errors name the
+    key of the profile file to change.
     """
 
     name: str = "generic"
@@ -83,6 +121,7 @@ class MachineProfile:
     envelope_min: tuple[float, float, float] = (0.0, 0.0, 0.0)
     envelope_max: tuple[float, float, float] = (300.0, 300.0, 100.0)
     max_feed: float = 50.0
+    min_feed: float = 0.01
     travel_feed: float = 20.0
     max_rotation: float = 40.0
     max_pressure: float = 100.0
@@ -99,24 +138,46 @@ class MachineProfile:
     pressure_template: str = "M800 P{port} Q{psi:.3f}"
     uv_on_template: str = ""
     uv_off_template: str = ""
+    source: str = BUILTIN
 
     def __post_init__(self) -> None:
+        check_line("machine profile key 'name'", self.name)
+        check_line("machine profile source", self.source)
         if self.dialect not in DIALECTS:
             raise _bad("dialect", f"must be one of {DIALECTS}; got {self.dialect!r}")
         lo = tuple(float(v) for v in self.envelope_min)
         hi = tuple(float(v) for v in self.envelope_max)
+        if not all(math.isfinite(v) for v in lo + hi):
+            raise _bad("envelope_max", f"corners must be finite (mm); got {lo} .. {hi}")
         if len(lo) != 3 or len(hi) != 3 or not all(a < b for a, b in zip(lo, hi, strict=False)):
             raise _bad("envelope_max", f"must exceed envelope_min on x, y, z; got {lo} .. {hi}")
         object.__setattr__(self, "envelope_min", lo)
         object.__setattr__(self, "envelope_max", hi)
-        for name in ("max_feed", "travel_feed", "max_rotation", "max_pressure", "lift"):
+        for name in (
+            "max_feed",
+            "min_feed",
+            "travel_feed",
+            "max_rotation",
+            "max_pressure",
+            "lift",
+        ):
             v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0):
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, int | float)
+                or not (math.isfinite(v) and v > 0)
+            ):
                 raise _bad(name, f"must be a finite number > 0; got {v!r}")
-        if not (0 <= self.min_pressure < self.max_pressure):
+        if not self.min_feed < self.max_feed:
+            raise _bad(
+                "min_feed", f"must be < max_feed ({self.max_feed} mm/s); got {self.min_feed}"
+            )
+        if not self.min_feed <= self.travel_feed:
+            raise _bad("travel_feed", f"must be >= min_feed ({self.min_feed} mm/s)")
+        if not (math.isfinite(self.min_pressure) and 0 <= self.min_pressure < self.max_pressure):
             raise _bad("min_pressure", f"must lie in [0, max_pressure); got {self.min_pressure}")
         letters = [self.x_axis, self.y_axis, self.z_axis, self.rotary_axis]
-        if any(len(a) != 1 or not a.isalpha() or not a.isupper() for a in letters):
+        if any(not isinstance(a, str) or len(a) != 1 or not ("A" <= a <= "Z") for a in letters):
             raise _bad("rotary_axis", f"axis letters must be single capitals; got {letters}")
         if len(set(letters)) != 4 or set(letters) & {"F", "G", "M", "P", "Q", "S", "N"}:
             raise _bad(
@@ -126,11 +187,25 @@ class MachineProfile:
             raise _bad("rotary_units", f"must be 'deg' or 'rad'; got {self.rotary_units!r}")
         if self.rotary_sign not in (1, -1):
             raise _bad("rotary_sign", f"must be +1 or -1; got {self.rotary_sign}")
+        for name in ("active_port", "passive_port"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 9999:
+                raise _bad(name, f"must be an integer in [0, 9999]; got {v!r}")
         if self.active_port == self.passive_port:
             raise _bad("passive_port", "must differ from active_port")
+        for name in ("pressure_template", "uv_on_template", "uv_off_template"):
+            check_line(f"machine profile key '{name}'", getattr(self, name))
         names = {f[1] for f in string.Formatter().parse(self.pressure_template) if f[1]}
         if names != {"port", "psi"}:
             raise _bad("pressure_template", f"must use exactly {{port}} and {{psi}}; got {names}")
+        for name in ("uv_on_template", "uv_off_template"):
+            if any(f[1] is not None for f in string.Formatter().parse(getattr(self, name))):
+                raise _bad(name, "takes no {fields}; write the line literally")
+
+    @property
+    def is_builtin(self) -> bool:
+        """True for the built-in default profile (no profile file was given)."""
+        return self.source == BUILTIN
 
     @property
     def feed_scale(self) -> float:
@@ -149,19 +224,39 @@ class MachineProfile:
         if "max_rotation_deg_s" in data:
             if "max_rotation" in data:
                 raise _bad("max_rotation", "give max_rotation (rad/s) or max_rotation_deg_s")
-            data["max_rotation"] = math.radians(float(data.pop("max_rotation_deg_s")))
-        known = {f.name for f in fields(cls)}
+            deg = data.pop("max_rotation_deg_s")
+            if isinstance(deg, bool) or not isinstance(deg, int | float):
+                raise _bad("max_rotation_deg_s", f"must be a number (deg/s); got {deg!r}")
+            data["max_rotation"] = math.radians(deg)
+        known = {f.name for f in fields(cls)} - {"source"}
         unknown = sorted(set(data) - known)
         if unknown:
             raise _bad(unknown[0], f"unknown setting; known: {sorted(known)}")
         for k in ("envelope_min", "envelope_max"):
             if k in data:
-                data[k] = tuple(data[k])
+                v = data[k]
+                if not isinstance(v, list | tuple) or not all(
+                    isinstance(c, int | float) and not isinstance(c, bool) for c in v
+                ):
+                    raise _bad(k, f"must be three numbers [x, y, z] (mm); got {v!r}")
+                data[k] = tuple(v)
+        for k, v in data.items():
+            expect = (str,) if isinstance(getattr(cls, k, None), str) else (int, float)
+            if isinstance(getattr(cls, k, None), tuple):
+                continue
+            if isinstance(v, bool) or not isinstance(v, expect):
+                raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r}")
         return cls(**data)
 
 
 def load_machine_profile(path: str | FilePath) -> MachineProfile:
     """Read a profile from a TOML file (a ``[machine]`` table or top-level keys)."""
-    with open(path, "rb") as fh:
-        data = tomllib.load(fh)
-    return MachineProfile.from_dict(data.get("machine", data))
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidParameterError(
+            str(path), f"is not a valid TOML machine profile: {exc}"
+        ) from None
+    profile = MachineProfile.from_dict(data.get("machine", data))
+    return replace(profile, source=check_line("machine profile path", FilePath(path).name))
