@@ -148,13 +148,13 @@ def _janus_curvature(lm: LatticeModel, fm: FilamentModel) -> tuple[float, float]
 
 
 def _additive(lm: LatticeModel, curvature: float, stretch: float = 1.0) -> Model:
+    # natural curvatures are per printed length (Model): a stretch changes rest lengths only
     k1, k2, _ = lm.printed
     b1, b2 = lm.side_basis
     rest = None if stretch == 1.0 else lm.model.network.edge_lengths * stretch
     return lm.model.with_natural(
-        curvature1=k1 / stretch + curvature * b1,
-        curvature2=k2 / stretch + curvature * b2,
-        twist=None if stretch == 1.0 else lm.printed[2] / stretch,
+        curvature1=k1 + curvature * b1,
+        curvature2=k2 + curvature * b2,
         rest_length=rest,
     )
 

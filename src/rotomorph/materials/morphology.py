@@ -7,6 +7,9 @@ kinetic analogy, e.g. Love, *A Treatise on the Mathematical Theory of Elasticity
 * radius ρ = K/(K² + τ²), pitch P = 2πτ/(K² + τ²) (τ > 0: right-handed),
 * end-to-end length per arc length L/L0 = abs(τ)/√(K² + τ²), times the axial stretch (1 + ε_c)
   (engineering) or exp(ε_c) (Hencky) when the centre line contracts,
+* natural curvature and twist are angles per unit *printed* length (material quantities), so an
+  axial stretch λ scales the helix uniformly: radius and pitch × λ, curvature and torsion of the
+  actuated centre line K/λ and τ/λ (a uniform strain is a similarity),
 * morphology parameter Λ = K/abs(τ): Λ ≥ 1 tight coils (L/L0 ≈ 1/Λ), Λ < 1 helices that open into
   nearly straight twisted filaments (L/L0 ≈ 1 − Λ²/2).
 """
@@ -35,7 +38,7 @@ class HelixShape:
     Attributes
     ----------
     curvature, torsion
-        K ≥ 0 and τ (1/mm).
+        K ≥ 0 and τ (1/mm) of the actuated centre line (per actuated arc length).
     radius, pitch
         Helix radius ρ and pitch P (mm); ``inf`` pitch for a straight rod, 0 for a ring.
     end_to_end_ratio
@@ -70,9 +73,10 @@ def free_helix(
     Parameters
     ----------
     curvature
-        Natural curvature magnitude K (1/mm), ≥ 0 (sign is absorbed in the frame).
+        Natural curvature magnitude K (1/mm of printed length), ≥ 0 (sign is absorbed in the
+        frame).
     torsion
-        Natural twist τ (1/mm), signed.
+        Natural twist τ (1/mm of printed length), signed.
     axial_strain
         Natural centre-line strain ε_c (dimensionless) scaling L/L0.
     measure
@@ -88,10 +92,10 @@ def free_helix(
     --------
     K = 0.59 mm⁻¹, τ = 0.1 mm⁻¹ (composite at ω* = 0.06): L/L0 ≈ 0.17, a coil.
     """
-    k = abs(float(curvature))
-    t = float(torsion)
+    k0 = abs(float(curvature))
+    t0 = float(torsion)
     eps = float(axial_strain)
-    if not all(math.isfinite(v) for v in (k, t, eps)):
+    if not all(math.isfinite(v) for v in (k0, t0, eps)):
         raise InvalidParameterError(
             "free_helix", "curvature, torsion and axial_strain must be finite"
         )
@@ -105,6 +109,8 @@ def free_helix(
         )
     if stretch <= 0.0:
         raise InvalidParameterError("axial_strain", f"gives a non-positive stretch {stretch}")
+    # angles per printed length over the stretched arc length: a similarity by the stretch
+    k, t = k0 / stretch, t0 / stretch
     k2t2 = k * k + t * t
     if k2t2 == 0.0 or (k < tol and abs(t) < tol):
         return HelixShape(k, t, 0.0, math.inf, stretch, 0.0, "straight")

@@ -156,9 +156,14 @@ class NaturalField:
         the active side flips (see :func:`continuous_sign`); the curvature increments carry the
         side.
     curvature1, curvature2, twist
-        ``(N-2,)`` natural curvature toward m1, m2 and twist at interior vertices (1/mm); the rod
-        core multiplies them by its Voronoi length to get integrated values. The printed part is
-        exact when multiplied by ``voronoi_length`` (printed).
+        ``(N-2,)`` natural curvature toward m1, m2 and twist at interior vertices: turning and
+        twist angle per unit *printed* length (1/mm). Times ``voronoi_length`` (printed) they
+        are the integrated natural values the rod uses, whatever the rest lengths: natural
+        angles are material quantities, so a uniform centre-line strain of any printed shape is
+        a similarity. In linear section theory (plane sections) the angle between two cross
+        sections a printed distance dS apart is κ dS, with κ from the section (fibre strains
+        ε_c − κ·x are relative to printed length), so the actuation increments are per printed
+        length too.
     voronoi_length
         ``(N-2,)`` printed Voronoi lengths (mm).
     rest_length

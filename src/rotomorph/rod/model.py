@@ -80,9 +80,12 @@ class Model:
         pointing into the active half. Default: space-parallel (twist-free) frames for a chain,
         ``+z`` projected on each edge otherwise.
     natural_curvature1, natural_curvature2, natural_twist
-        Per-stencil natural curvature toward ``m1``, toward ``m2`` and natural twist (1/mm,
-        pointwise values; multiplied internally by the Voronoi length of rest lengths).
-        Default: those of the reference configuration (stress-free as printed).
+        Per-stencil natural curvature toward ``m1``, toward ``m2`` and natural twist: turning
+        and twist angle per unit *reference* (printed) arc length (1/mm). The rod uses the
+        integrated values ``natural × reference Voronoi length`` (dimensionless angles), so
+        they do not change when only the rest lengths do: a uniform natural strain of any
+        printed shape is a similarity. Default: those of the reference configuration
+        (stress-free as printed).
     rest_length
         Per-edge natural length (mm). Default: reference lengths.
 
@@ -188,8 +191,15 @@ class Model:
         return b1, b2, c
 
     def integrated_natural(self) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Natural ``(kappa1, kappa2, tau)`` per stencil, integrated (dimensionless)."""
-        v = self.voronoi_length
+        """Natural ``(kappa1, kappa2, tau)`` per stencil, integrated (dimensionless).
+
+        Natural turning and twist angles are material quantities: the pointwise values are per
+        unit reference length, so they are integrated over the reference Voronoi length, not
+        over the (possibly strained) rest lengths. Multiplying a per-length value by a length
+        other than the one it was divided by would make a curved filament lose turning angle
+        when its centre-line merely contracts.
+        """
+        v = self._reference_voronoi()
         # the natural fields are arrays once __post_init__ has run
         k1 = cast(FloatArray, self.natural_curvature1)
         k2 = cast(FloatArray, self.natural_curvature2)
@@ -212,7 +222,9 @@ class Model:
     ) -> Model:
         """A copy with new natural curvatures, twist (1/mm, per stencil) or rest lengths (mm).
 
-        Arguments left ``None`` keep their current values.
+        Curvatures and twist are per unit reference length (class docstring): changing only
+        ``rest_length`` keeps every natural turning angle. Arguments left ``None`` keep their
+        current values.
         """
         return replace(
             self,
