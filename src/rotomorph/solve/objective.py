@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.contact.potential import Contact, InfeasibleContactError
 from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.assembly import (
     evaluate_network,
@@ -24,6 +25,7 @@ from rotomorph.rod.assembly import (
 )
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
+from rotomorph.solve.contact_term import ContactTerm, tangent_rigid_modes
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.retraction import (
@@ -41,7 +43,14 @@ class RodObjective:
 
     has_convex_hessian = True  # the Gauss–Newton part of the stencil Hessians
 
-    def __init__(self, model: Model, state: State, supports: Supports, loads: Loads) -> None:
+    def __init__(
+        self,
+        model: Model,
+        state: State,
+        supports: Supports,
+        loads: Loads,
+        contact: Contact | None = None,
+    ) -> None:
         self.model = model
         net, st, lay = model.network, model.stencils, model.layout
         self._edges = np.ascontiguousarray(net.edges)
@@ -92,6 +101,7 @@ class RodObjective:
         self._moment_edges, self._moments = self._edge_moments(loads)
         if (
             supports.is_free
+            and (contact is None or contact.floor is None)
             and np.linalg.norm(self._external[self._pos_index].reshape(-1, 3).sum(0)) > 0
         ):
             raise InvalidParameterError(
@@ -110,8 +120,28 @@ class RodObjective:
         self._mref = np.empty(st.count)
         self._setup_matrix(topo)
         self._fixed_mask = fixed
+        self._contact: ContactTerm | None = None
+        self._contact_hess = None
+        self._floor_normal = None if contact is None or contact.floor is None else contact.floor
         self.set_base(state)
         self._setup_scales(loads)
+        if contact is not None:
+            self._contact = ContactTerm(
+                contact,
+                net,
+                lay.pos,
+                reduced,
+                force_scale=max(
+                    self.force_scale / np.sqrt(n),
+                    float(np.abs(self._external[self._pos_index]).max(initial=0.0)),
+                ),
+            )
+            self._contact.potential.check_admissible(state.positions, "initial")
+
+    @property
+    def contact(self):  # type: ignore[no-untyped-def]
+        """The bound :class:`~rotomorph.contact.potential.ContactPotential`, or None."""
+        return None if self._contact is None else self._contact.potential
 
     # ------------------------------------------------------------------ set-up
     def _external_forces(self, loads: Loads) -> FloatArray:
@@ -263,6 +293,23 @@ class RodObjective:
             if need_grad or need_hess:
                 raise
             return np.inf, None, None
+        if self._contact is not None:
+            if not (need_grad or need_hess):
+                # a line-search trial: the straight path from the accepted iterate must be
+                # provably free of contact, else the trial counts as infinite energy
+                if not self._contact.path_is_free(self.base.positions, pos):
+                    return np.inf, None, None
+            ce, cg, ch = self._contact.evaluate(pos, need_grad, int(need_hess))
+            if not np.isfinite(ce):
+                if need_grad or need_hess:
+                    raise InfeasibleContactError(
+                        "positions", "an iterate touches or interpenetrates (solver bug)"
+                    )
+                return np.inf, None, None
+            energy += ce
+            if cg is not None:
+                self._grad[self._pos_index] += cg
+            self._contact_hess = ch
         return self._finish(u, pos, theta, energy, need_grad, need_hess)
 
     def _evaluate_network(self, pos, theta, need_grad, need_hess):  # type: ignore[no-untyped-def]
@@ -351,14 +398,20 @@ class RodObjective:
                 self.bandwidth,
                 self._ab,
             )
-            return BandedMatrix(self._ab.copy(order="F"), self.bandwidth)
+            banded = BandedMatrix(self._ab.copy(order="F"), self.bandwidth)
+            if self._contact is not None and self._contact_hess is not None:
+                return self._contact.add_to(banded, self._contact_hess)
+            return banded
         scatter_sparse(self._st_hess, self._st_slot, self._ed_hess, self._ed_slot, self._data)
         n = len(self.free)
         indices, indptr = self._csc_pattern
         csc = sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
         if self._topo.get("symbolic") is None:
             self._topo["symbolic"] = analyse(csc)
-        return SparseMatrix(csc, self._topo["symbolic"])
+        rod = SparseMatrix(csc, self._topo["symbolic"])
+        if self._contact is not None and self._contact_hess is not None:
+            return self._contact.add_to(rod, self._contact_hess)
+        return rod
 
     def project(self, d: FloatArray) -> FloatArray:
         """Remove the rigid motion from a step of a free body (M-orthogonal projection).
@@ -372,6 +425,8 @@ class RodObjective:
             return d
         du = np.zeros(self.model.layout.count)
         du[self.free] = d
+        if self._floor_normal is not None:
+            return self._project_tangent(du)
         dx = np.ascontiguousarray(du[self._pos_index].reshape(-1, 3))
         dth = np.ascontiguousarray(du[self._theta_index])
         remove_rigid_motion(
@@ -380,6 +435,25 @@ class RodObjective:
         du[self._pos_index] = dx.ravel()
         du[self._theta_index] = dth
         return du[self.free]
+
+    def _project_tangent(self, du: FloatArray) -> FloatArray:
+        """Remove the rigid motions tangent to the floor (M-orthogonal projection)."""
+        assert self._floor_normal is not None
+        lay = self.model.layout
+        U = tangent_rigid_modes(
+            self.base.positions,
+            self.base.tangents,
+            np.asarray(self._floor_normal.normal),
+            lay.pos,
+            lay.theta,
+            lay.count,
+        )
+        m = np.zeros(lay.count)
+        m[self._pos_index] = np.repeat(self._node_metric, 3)
+        m[self._theta_index] = self._theta_metric
+        G = (U * m) @ U.T
+        c = np.linalg.solve(G, (U * m) @ du)
+        return (du - c @ U)[self.free]
 
     def shift_floor(self, g: FloatArray) -> float:
         """Smallest modified-Newton shift for a free body, 0 otherwise.
@@ -407,7 +481,14 @@ class RodObjective:
     def max_step(self, q: FloatArray, d: FloatArray) -> float:
         """Largest step fraction that turns no edge by more than one radian."""
         angle = self._max_edge_rotation(d)
-        return 1.0 if angle <= 1.0 else 1.0 / angle
+        bound = 1.0 if angle <= 1.0 else 1.0 / angle
+        if self._contact is not None:
+            du = np.zeros(self.model.layout.count)
+            du[self.free] = d
+            pos, _ = self._unpack(q)
+            dpos = du[self._pos_index].reshape(-1, 3)
+            bound = min(bound, self._contact.step_bound(pos, bound * dpos) * bound)
+        return bound
 
     def _max_edge_rotation(self, d: FloatArray) -> float:
         du = np.zeros(self.model.layout.count)
@@ -424,6 +505,8 @@ class RodObjective:
         """Gauss–Newton Hessian at ``q``: positive semidefinite, for indefinite iterates."""
         pos, theta = self._unpack(q)
         self._evaluate_network(pos, theta, False, 2)
+        if self._contact is not None:
+            self._contact_hess = self._contact.evaluate(pos, False, 2)[2]
         return self._hessian()
 
     def metric(self) -> FloatArray:

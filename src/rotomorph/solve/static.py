@@ -6,6 +6,7 @@ import time
 from dataclasses import dataclass
 
 from rotomorph._typing import FloatArray
+from rotomorph.contact.potential import Contact, ContactPotential
 from rotomorph.errors import ConvergenceError
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
@@ -34,6 +35,10 @@ class StaticResult:
         Weighted gradient norm relative to the problem's force scale.
     wall_time
         Seconds spent in the solve.
+    contact
+        The contact model bound to the network when the solve had contact (None otherwise):
+        ``result.contact.forces(result.positions)``, ``.clearance(...)``,
+        ``.active_contacts(...)``.
     """
 
     state: State
@@ -43,6 +48,7 @@ class StaticResult:
     energy: float
     residual: float
     wall_time: float
+    contact: ContactPotential | None = None
 
     @property
     def positions(self) -> FloatArray:
@@ -56,6 +62,7 @@ def solve_static(
     loads: Loads | None = None,
     initial: State | None = None,
     options: NewtonOptions | None = None,
+    contact: Contact | None = None,
 ) -> StaticResult:
     """Find a stable equilibrium of ``model`` under ``supports`` and ``loads``.
 
@@ -73,16 +80,21 @@ def solve_static(
         previous equilibrium here.
     options
         Newton settings.
+    contact
+        Self-contact and rigid obstacles (:class:`~rotomorph.contact.Contact`); no iterate
+        ever interpenetrates. The initial state must be separated.
 
     Raises
     ------
+    InfeasibleContactError
+        If the initial state already touches or interpenetrates.
     ConvergenceError
         If Newton's method does not converge; ``error.result`` holds the diagnostics
         (:class:`~rotomorph.solve.result.NewtonResult`) and ``error.state`` the last iterate.
     """
     t0 = time.perf_counter()
     state = model.reference_state() if initial is None else initial
-    obj = RodObjective(model, state, supports or Supports(), loads or Loads())
+    obj = RodObjective(model, state, supports or Supports(), loads or Loads(), contact)
     res = minimize(obj, obj.vector(), options)
     final = obj.base
     if res.status is not Status.CONVERGED:
@@ -102,4 +114,5 @@ def solve_static(
         energy=res.energy,
         residual=res.residual,
         wall_time=time.perf_counter() - t0,
+        contact=obj.contact,
     )

@@ -1,0 +1,93 @@
+r"""Collision-free step bounds by additive conservative advancement (compiled).
+
+Along the straight path :math:`x(t) = x_0 + t\,\Delta x`, the distance between a point of
+segment P and a point of segment Q changes at most by the largest relative motion of their
+nodes: subtracting the pair's mean node displacement ``m`` (which moves both alike),
+:math:`|\dot d| \le l_P + l_Q` with :math:`l_P = \max_{k \in P} |\Delta x_k - m|` (every point
+of a segment is a convex combination of its end nodes). From a gap ``g = d − d_min`` the pair
+therefore cannot touch within :math:`\delta t < g / (l_P + l_Q)`. Advancing by a fraction of
+that and re-measuring the gap is the additive CCD of Li, Kaufman & Jiang, "Codimensional
+Incremental Potential Contact", ACM TOG 40(4) 170 (2021), Alg. 1: every ``t`` it returns is
+provably collision-free (not an estimate). A node against a plane moves linearly in height,
+so its time of impact is exact.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from rotomorph.contact.distance import closest_parameters
+
+ADVANCE = 0.9  # fraction of the provably safe advance taken per sub-step
+
+
+@njit(cache=True)
+def _distance(x0, dx, t, i0, i1, j0, j1):  # pragma: no cover - compiled
+    p0 = x0[i0] + t * dx[i0]
+    p1 = x0[i1] + t * dx[i1]
+    q0 = x0[j0] + t * dx[j0]
+    q1 = x0[j1] + t * dx[j1]
+    s, u = closest_parameters(p0, p1, q0, q1)
+    r = p0 + s * (p1 - p0) - q0 - u * (q1 - q0)
+    return np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+
+
+@njit(cache=True)
+def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragma: no cover
+    """Largest ``t`` in [0, 1] such that no pair comes within ``dmin`` on ``[0, t]``.
+
+    A pair stops the advance once it has closed ``close_fraction`` of its initial gap
+    (``close_fraction = 1``: only contact or ``max_substeps`` stop it). Returns 0 when a pair
+    starts at or inside contact.
+    """
+    tmin = 1.0
+    for p in range(pairs.shape[0]):
+        idx = (pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3])
+        m = (dx[idx[0]] + dx[idx[1]] + dx[idx[2]] + dx[idx[3]]) / 4.0
+        lp = 0.0
+        lq = 0.0
+        for n in range(4):
+            v = dx[idx[n]] - m
+            ln = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            if n < 2:
+                lp = max(lp, ln)
+            else:
+                lq = max(lq, ln)
+        rate = lp + lq
+        gap0 = _distance(x0, dx, 0.0, idx[0], idx[1], idx[2], idx[3]) - dmin[p]
+        if gap0 <= 0.0:
+            return 0.0
+        if rate * tmin <= ADVANCE * gap0:
+            continue  # cannot close within the current bound
+        t = 0.0
+        gap = gap0
+        for _ in range(max_substeps):
+            dt = ADVANCE * gap / rate
+            if t + dt >= tmin:
+                t = tmin
+                break
+            t += dt
+            gap = _distance(x0, dx, t, idx[0], idx[1], idx[2], idx[3]) - dmin[p]
+            if gap <= (1.0 - close_fraction) * gap0:
+                break
+        tmin = min(tmin, t)
+    return tmin
+
+
+@njit(cache=True)
+def plane_step_bound(x0, dx, nodes, normal, offset, dmin, close_fraction):  # pragma: no cover
+    """Largest ``t`` in [0, 1] keeping every node's height above the plane ``> dmin``."""
+    tmin = 1.0
+    for p in range(nodes.shape[0]):
+        i = nodes[p]
+        h = normal[0] * x0[i, 0] + normal[1] * x0[i, 1] + normal[2] * x0[i, 2] - offset
+        v = normal[0] * dx[i, 0] + normal[1] * dx[i, 1] + normal[2] * dx[i, 2]
+        gap = h - dmin[p]
+        if gap <= 0.0:
+            return 0.0
+        if v >= 0.0:
+            continue
+        hit = gap / -v  # exact time of touching
+        tmin = min(tmin, close_fraction * hit if close_fraction < 1.0 else hit * (1.0 - 1e-12))
+    return tmin

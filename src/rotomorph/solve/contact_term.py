@@ -1,0 +1,149 @@
+"""Contact composed into the rod objective: the barrier on the free DOFs and its step bound.
+
+The rod objective adds :class:`ContactTerm`'s energy, gradient and Hessian to its own, so the
+Newton step, the line search (the merit function is the total energy) and the Hessian stay
+consistent. Two more duties:
+
+* **step bound**: the largest fraction of a Newton step that is provably free of contact
+  (the objective's ``max_step``), and a check that the straight path from the last accepted
+  iterate to a line-search trial point is free of contact (a trial that fails it has infinite
+  energy), so no accepted iterate can tunnel through a filament;
+* **rigid motions on a floor**: a free body resting on a frictionless floor keeps only the
+  three rigid motions tangent to the floor (two translations, the rotation about the normal),
+  which are removed from every step instead of all six.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+import scipy.sparse as sp
+
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.contact.potential import Contact, ContactPotential
+from rotomorph.design.network import Network
+from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
+from rotomorph.solve.sparse_cholesky import Symbolic, analyse
+
+__all__ = ["ContactTerm", "banded_to_csc"]
+
+_SYMBOLIC_CACHE = 8  # contact patterns remembered per term (a ramp revisits a few)
+
+
+class ContactTerm:
+    """A :class:`ContactPotential` seen through a rod objective's DOF layout.
+
+    Parameters
+    ----------
+    contact
+        Settings.
+    network
+        The printed network.
+    pos_dof
+        Layout index of each node's x coordinate ``(N,)`` (y, z follow).
+    reduced
+        Reduced (free) index of every layout DOF, -1 where fixed ``(ndof,)``.
+    force_scale
+        Typical nodal force (N) for the default barrier stiffness.
+    """
+
+    def __init__(
+        self,
+        contact: Contact,
+        network: Network,
+        pos_dof: IntArray,
+        reduced: IntArray,
+        force_scale: float,
+    ) -> None:
+        self.potential = ContactPotential(contact, network, force_scale=force_scale)
+        coord = (pos_dof[:, None] + np.arange(3)).ravel()
+        self._coord_reduced = reduced[coord]  # node coordinate 3i+k -> reduced index or -1
+        self._nfree = int((reduced >= 0).sum())
+        self._symbolic: OrderedDict[int, tuple[bytes, bytes, Symbolic]] = OrderedDict()
+
+    # ------------------------------------------------------------------ energy
+    def evaluate(
+        self, pos: FloatArray, need_grad: bool, need_hess: int
+    ) -> tuple[float, FloatArray | None, sp.csc_matrix | None]:
+        """Energy, gradient on node coordinates ``(3N,)`` and Hessian on the free DOFs."""
+        e, g, trip = self.potential.evaluate(pos, need_grad, need_hess)
+        if not np.isfinite(e):
+            return np.inf, None, None
+        hess = None
+        if trip is not None and len(trip[2]):
+            r = self._coord_reduced[trip[0]]
+            c = self._coord_reduced[trip[1]]
+            ok = (r >= 0) & (c >= 0)
+            if ok.any():
+                n = self._nfree
+                hess = sp.csc_matrix((trip[2][ok], (r[ok], c[ok])), shape=(n, n))
+        return e, (None if g is None else g.ravel()), hess
+
+    def add_to(self, rod: BandedMatrix | SparseMatrix, contact: sp.csc_matrix) -> SparseMatrix:
+        """The rod Hessian plus the contact Hessian, with a cached symbolic analysis."""
+        base = banded_to_csc(rod) if isinstance(rod, BandedMatrix) else rod.csc
+        total = (base + contact).tocsc()
+        total.sum_duplicates()
+        total.sort_indices()
+        key = (total.indptr.tobytes(), total.indices.tobytes())
+        h = hash(key)
+        hit = self._symbolic.get(h)
+        if hit is not None and hit[0] == key[0] and hit[1] == key[1]:
+            self._symbolic.move_to_end(h)
+            return SparseMatrix(total, hit[2])
+        sym = analyse(total)
+        self._symbolic[h] = (key[0], key[1], sym)
+        if len(self._symbolic) > _SYMBOLIC_CACHE:
+            self._symbolic.popitem(last=False)
+        return SparseMatrix(total, sym)
+
+    # ------------------------------------------------------------------ steps
+    def step_bound(self, pos: FloatArray, dpos: FloatArray) -> float:
+        """Provably contact-free fraction of the straight step ``pos -> pos + dpos``."""
+        return self.potential.step_bound(pos, dpos)
+
+    def path_is_free(self, start: FloatArray, end: FloatArray) -> bool:
+        """Whether the straight path between two configurations never touches."""
+        return self.potential.path_is_free(start, end)
+
+
+def banded_to_csc(H: BandedMatrix) -> sp.csc_matrix:
+    """The full symmetric CSC matrix of upper banded storage."""
+    n, u = H.n, H.u
+    rows, cols, vals = [], [], []
+    for k in range(u + 1):
+        d = H.ab[u - k, k:]
+        i = np.arange(n - k)
+        rows += [i, i + k] if k else [i]
+        cols += [i + k, i] if k else [i]
+        vals += [d, d] if k else [d]
+    return sp.csc_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+    )
+
+
+def tangent_rigid_modes(
+    positions: FloatArray,
+    tangents: FloatArray,
+    normal: FloatArray,
+    pos_dof: IntArray,
+    theta_dof: IntArray,
+    ndof: int,
+) -> FloatArray:
+    """Rigid motions tangent to a plane of ``normal``: two translations and the rotation
+    about the normal through the centroid (with its twist part ``n . t``), ``(3, ndof)``."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    a = np.cross(n, [1.0, 0.0, 0.0])
+    if np.linalg.norm(a) < 0.5:
+        a = np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    modes = np.zeros((3, ndof))
+    coord = pos_dof[:, None] + np.arange(3)
+    modes[0][coord] = a
+    modes[1][coord] = b
+    r = positions - positions.mean(axis=0)
+    modes[2][coord] = np.cross(n, r)
+    modes[2][theta_dof] = tangents @ n
+    return modes

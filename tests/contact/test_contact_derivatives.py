@@ -1,0 +1,117 @@
+"""Contact energy: gradients and Hessians against central finite differences."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotomorph.contact import Contact, ContactPotential, Cylinder, Floor, Sphere
+from rotomorph.contact.distance import closest_parameters, segment_distance2
+from rotomorph.design.network import Network
+
+
+def _d2(x, need=False):
+    g, h = np.empty(12), np.empty((12, 12))
+    d = segment_distance2(x[0:3], x[3:6], x[6:9], x[9:12], need, g, h)
+    return d, g, h
+
+
+def _same_type(x, eps):
+    """True when the closest-point type (which parameters are interior) is the same at +-eps."""
+
+    def kind(y):
+        s, t = closest_parameters(y[0:3], y[3:6], y[6:9], y[9:12])
+        return (0 < s < 1, 0 < t < 1)
+
+    k = kind(x)
+    return all(kind(x + eps * e) == k and kind(x - eps * e) == k for e in np.eye(len(x)))
+
+
+@pytest.mark.parametrize("kind", ["crossing", "parallel", "point"])
+def test_squared_distance_matches_finite_differences(kind):
+    rng = np.random.default_rng(7)
+    eps, checked = 1e-6, 0
+    for _ in range(40):
+        x = rng.standard_normal(12)
+        if kind == "parallel":  # nearly parallel, overlapping
+            x[9:12] = x[6:9] + (x[3:6] - x[0:3]) * (0.5 + rng.random())
+            x[9:12] += 1e-2 * rng.standard_normal(3)
+        if kind == "point":
+            x[9:12] = x[6:9]
+        if kind != "point" and not _same_type(x, eps):
+            continue
+        _, g, h = _d2(x, True)
+        cols = 6 if kind == "point" else 12  # a point's two copies are one obstacle DOF
+        gf = np.array([(_d2(x + eps * e)[0] - _d2(x - eps * e)[0]) / (2 * eps) for e in np.eye(12)])
+        hf = np.array([(_d2(x + eps * e)[1] - _d2(x - eps * e)[1]) / (2 * eps) for e in np.eye(12)])
+        assert np.allclose(g[:cols], gf[:cols], rtol=1e-6, atol=1e-7)
+        assert np.allclose(h[:cols, :cols], hf[:cols, :cols], rtol=1e-5, atol=1e-6)
+        checked += 1
+    assert checked >= 20
+
+
+def _two_segments(kind, rng):
+    """Two 3-node filaments near contact (radius 0.5: contact distance 1.0)."""
+    if kind == "crossing":
+        a = np.array([[-1.0, 0.2, 0], [0.1, 0.0, 0], [1.1, -0.1, 0]])
+        b = np.array([[0.2, -1.0, 1.003], [0.0, 0.1, 1.004], [-0.1, 1.0, 1.002]])
+    else:  # parallel, offset along the axis
+        a = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]])
+        b = np.array([[0.4, 1.004, 0.0], [1.4, 1.003, 0.001], [2.4, 1.002, 0.0]])
+    pts = np.vstack([a, b]) + 2e-4 * rng.standard_normal((6, 3))
+    printed = pts + np.array([[0, 0, 0]] * 3 + [[0, 0, 5.0]] * 3)  # printed apart: not fused
+    return Network(printed, [[0, 1], [1, 2], [3, 4], [4, 5]]), pts
+
+
+def _check_potential(pot, x, eps=1e-7):
+    e, g, trip = pot.evaluate(x, True, 1)
+    assert np.isfinite(e) and e > 0
+    n3 = x.size
+    H = np.zeros((n3, n3))
+    np.add.at(H, (trip[0], trip[1]), trip[2])
+    gf = np.zeros(n3)
+    hf = np.zeros((n3, n3))
+    for k in range(n3):
+        dx = np.zeros(n3)
+        dx[k] = eps
+        ep, gp, _ = pot.evaluate(x + dx.reshape(x.shape), True, 0)
+        em, gm, _ = pot.evaluate(x - dx.reshape(x.shape), True, 0)
+        gf[k] = (ep - em) / (2 * eps)
+        hf[:, k] = (gp - gm).ravel() / (2 * eps)
+    scale = np.abs(g).max()
+    assert np.abs(g.ravel() - gf).max() <= 1e-5 * scale
+    assert np.abs(H - hf).max() <= 1e-4 * np.abs(H).max()
+    assert np.allclose(H, H.T, atol=1e-12 * np.abs(H).max())
+
+
+@pytest.mark.parametrize("kind", ["crossing", "parallel"])
+def test_self_contact_barrier_matches_finite_differences(kind, rng):
+    net, pts = _two_segments(kind, rng)
+    pot = ContactPotential(Contact(radius=0.5, activation_distance=0.01, stiffness=1.0), net)
+    _check_potential(pot, pts)
+
+
+@pytest.mark.parametrize(
+    "obstacle",
+    [
+        Floor(height=-0.505),
+        Sphere(centre=(0.3, 0.0, -2.506), radius=2.0),
+        Cylinder.along((0.4, 0.0, -1.006), (0.1, 1.0, 0.0), radius=0.5, length=10.0),
+    ],
+    ids=["plane", "sphere", "cylinder"],
+)
+def test_obstacle_barrier_matches_finite_differences(obstacle, rng):
+    pts = np.array([[-1.0, 0.0, 0.0], [0.2, 0.1, 0.001], [1.2, -0.1, 0.002]])
+    pts += 1e-4 * rng.standard_normal(pts.shape)
+    net = Network(pts, [[0, 1], [1, 2]])
+    contact = Contact(radius=0.5, obstacles=(obstacle,), activation_distance=0.02, stiffness=1.0)
+    _check_potential(ContactPotential(contact, net), pts)
+
+
+def test_psd_mode_is_positive_semidefinite(rng):
+    net, pts = _two_segments("crossing", rng)
+    pot = ContactPotential(Contact(radius=0.5, activation_distance=0.01, stiffness=1.0), net)
+    _, _, trip = pot.evaluate(pts, False, 2)
+    H = np.zeros((18, 18))
+    np.add.at(H, (trip[0], trip[1]), trip[2])
+    assert np.linalg.eigvalsh(H).min() >= -1e-9 * np.abs(H).max()

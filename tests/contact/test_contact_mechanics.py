@@ -1,0 +1,142 @@
+"""Contact against exact answers: a beam pressed onto a crossing rod, a filament on the floor."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotomorph.contact import (
+    Contact,
+    ContactPotential,
+    Cylinder,
+    Floor,
+    InfeasibleContactError,
+    Sphere,
+)
+from rotomorph.design.network import Network
+from rotomorph.errors import InvalidParameterError
+from rotomorph.rod.model import Model
+from rotomorph.solve.loads import Gravity, Loads, Supports
+from rotomorph.solve.static import solve_static
+
+R = 0.5  # filament radius (mm)
+E = 1.0  # modulus (MPa)
+
+
+def _beam_on_rod(load_factor: float, length: float = 40.0, gap: float = 0.2):
+    """Simply supported beam B (41 nodes, along x) above a fixed rod A (along y) crossing it at
+    mid-span, centre lines 2R + gap apart; a mid-span load ``load_factor`` times the load that
+    closes the gap. B's axial stiffness is 1 % of E A: with both ends pinned, the membrane
+    tension of an inextensible beam would add ~ 1.8 (gap/R)^2 = 28 % to its stiffness; at 1 % it
+    adds 0.3 %, the roller support beam theory assumes."""
+    nb, na = 41, 11
+    xb = np.linspace(-length / 2, length / 2, nb)
+    beam = np.stack([xb, 0 * xb, np.full(nb, 2 * R + gap)], 1)
+    ya = np.linspace(-5.0, 5.0, na)
+    rod = np.stack([0 * ya, ya, 0 * ya], 1)
+    chain = lambda k, off: off + np.stack([np.arange(k - 1), np.arange(1, k)], 1)  # noqa: E731
+    net = Network(np.vstack([beam, rod]), np.vstack([chain(nb, 0), chain(na, nb)]))
+    EI = E * np.pi * R**4 / 4
+    model = Model(net, EI, EI, EI / 1.5, 1e-2 * E * np.pi * R**2)
+    supports = Supports(
+        pinned_nodes=(0, nb - 1, *range(nb, nb + na)),
+        fixed_twist_edges=(0, *range(nb - 1, nb + na - 2)),
+    )
+    closing = 48 * EI * gap / length**3
+    loads = Loads(forces=((nb // 2, (0.0, 0.0, -load_factor * closing)),))
+    return model, supports, loads, closing, nb
+
+
+def test_beam_pressed_on_crossing_rod_carries_load_minus_spring_force():
+    model, supports, loads, closing, nb = _beam_on_rod(3.0)
+    contact = Contact(radius=R, activation_distance=2e-3)
+    res = solve_static(model, supports, loads, contact=contact)
+    force = res.contact.forces(res.positions)[:nb, 2].sum()
+    expected = 3.0 * closing - closing  # P - 48 EI delta0 / L^3
+    assert force == pytest.approx(expected, rel=0.02)
+    # the rod pushes the beam up by exactly what it pushes itself down
+    assert res.contact.forces(res.positions)[nb:, 2].sum() == pytest.approx(-force, rel=1e-9)
+    assert 1.0 < res.contact.clearance(res.positions) < 1.0 + 2e-3 / (2 * R) + 1e-12
+    assert res.contact.active_contacts(res.positions) > 0
+
+
+def test_beam_below_the_closing_load_bends_freely():
+    model, supports, loads, _, nb = _beam_on_rod(0.5)
+    res = solve_static(model, supports, loads, contact=Contact(radius=R, activation_distance=2e-3))
+    deflection = 2 * R + 0.2 - res.positions[nb // 2, 2]
+    assert deflection == pytest.approx(0.1, rel=0.01)  # P L^3 / 48 EI
+    assert res.contact.active_contacts(res.positions) == 0
+
+
+def _filament(height: float, n: int = 21):
+    x = np.linspace(0.0, 10.0, n)
+    pts = np.stack([x, 0.3 * np.sin(x / 3), np.full(n, height)], 1)
+    A, I = np.pi * R**2, np.pi * R**4 / 4
+    return Model.chain(
+        pts,
+        bending_stiffness1=E * I,
+        bending_stiffness2=E * I,
+        twist_stiffness=E * I / 1.5,
+        axial_stiffness=E * A,
+    ), pts
+
+
+def test_filament_rests_on_floor_with_reaction_equal_to_buoyant_weight():
+    model, pts = _filament(1.2 * R)
+    gravity = Gravity(density=1.2, area=np.pi * R**2, fluid_density=0.97)
+    res = solve_static(model, loads=Loads(gravity=gravity), contact=Contact(R, (Floor(),)))
+    assert res.residual < 1e-8
+    lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    weight = float((gravity.line_weight(len(lengths)) * lengths).sum())
+    reaction = res.contact.forces(res.positions).sum(axis=0)
+    assert reaction[2] == pytest.approx(weight, rel=1e-6)
+    assert np.allclose(reaction[:2], 0.0)
+    heights = res.positions[:, 2] - R
+    assert np.all(heights > 0) and np.all(heights < res.contact.dhat)
+    # frictionless floor: the in-plane rigid motions were removed, not pinned by a support
+    assert np.allclose(res.positions[:, :2].mean(0), pts[:, :2].mean(0), atol=1e-9)
+
+
+def test_free_body_without_floor_under_gravity_is_refused():
+    model, _ = _filament(1.2 * R)
+    gravity = Gravity(density=1.2, area=np.pi * R**2, fluid_density=0.97)
+    with pytest.raises(InvalidParameterError, match="free body"):
+        solve_static(model, loads=Loads(gravity=gravity), contact=Contact(R))
+
+
+def test_interpenetrating_start_is_refused():
+    model, _ = _filament(0.8 * R)
+    with pytest.raises(InfeasibleContactError, match="interpenetrate"):
+        solve_static(model, Supports(pinned_nodes=(0,)), contact=Contact(R, (Floor(),)))
+
+
+def test_step_bound_stops_a_tunnelling_step():
+    """Two crossing segments 1.1 apart (contact at 1.0); the step moves one 3 mm through the
+    other, whose end point is again clear: the bound stops it before touching."""
+    net = Network([[-1, 0, 0], [1, 0, 0], [0, -1, 1.1], [0, 1, 1.1]], [[0, 1], [2, 3]])
+    pot = ContactPotential(Contact(radius=0.5, activation_distance=0.01), net)
+    x = net.nodes.copy()
+    dx = np.zeros_like(x)
+    dx[2:, 2] = -3.0
+    t = pot.step_bound(x, dx)
+    assert 0 < t < 0.1 / 3.0
+    assert pot.clearance(x + t * dx) > 1.0
+    assert not pot.path_is_free(x, x + dx)
+    assert pot.path_is_free(x, x + 0.5 * t * dx)
+
+
+def test_obstacle_constructors_check_units_and_shapes():
+    with pytest.raises(InvalidParameterError, match=r"Sphere\.radius"):
+        Sphere((0, 0, 0), -1.0)
+    with pytest.raises(InvalidParameterError, match=r"Cylinder\.end"):
+        Cylinder((0, 0, 0), (0, 0, 0), 1.0)
+    with pytest.raises(InvalidParameterError, match=r"Floor\.normal"):
+        Floor(0.0, (0, 0, 0))
+    with pytest.raises(InvalidParameterError, match=r"Contact\.radius"):
+        Contact(radius=0.0)
+    with pytest.raises(InvalidParameterError, match=r"Contact\.obstacles"):
+        Contact(radius=0.3, obstacles=("floor",))  # type: ignore[arg-type]
+    cyl = Cylinder.along((0, 0, 1), (1, 0, 0), radius=1.75, length=20.0)
+    assert cyl.start == (-10.0, 0.0, 1.0) and cyl.moved((0, 0, 1)).end == (10.0, 0.0, 2.0)
+    assert Floor(normal=(0, 0, 2)).normal == (0.0, 0.0, 1.0)
+    assert Sphere((0, 0, 0), 2.5).moved((1, 0, 0)).centre == (1.0, 0.0, 0.0)
