@@ -7,6 +7,7 @@ Commands::
     rotomorph simulate DESIGN.toml -o OUT/    predicted shapes over heating (HDF5, figures, …)
     rotomorph plot RESULT.h5 -o DIR           figures and GIF from a results file
     rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
+    rotomorph sweep SWEEP.toml -o DIR         parameter study (resumable; --scheduler for Dask)
 
 Exit codes: 0 success; 1 the computation failed (solver did not converge);
 2 bad input (command line, design file, machine limits, missing file, existing output folder).
@@ -334,6 +335,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="coarse and fast (for tests)")
     p.add_argument("--force", action="store_true", help="replace a non-empty OUT")
     p.set_defaults(func=_cmd_paper)
+
+    from rotomorph.sweep.command import add_arguments, command
+
+    p = sub.add_parser("sweep", help="run a parameter study", description=command.__doc__)
+    add_arguments(p)
+    p.set_defaults(func=command)
     return parser
 
 

@@ -1,0 +1,110 @@
+"""The ``rotomorph sweep`` command: parser arguments and the command (logic lives here).
+
+``rotomorph sweep SWEEP.toml -o DIR [--scheduler tcp://HOST:PORT | --workers N] [--plot]``
+runs (or resumes) the sweep into ``DIR`` with a progress bar (done / failed / remaining and an
+ETA) and prints a one-line summary. ``rotomorph sweep --schema`` prints the sweep file's JSON
+Schema. Running the same command again after an interruption computes only the missing runs.
+Exit code 1 when runs were lost to a crashed worker (run again to finish them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from rotomorph.errors import InvalidParameterError
+
+__all__ = ["add_arguments", "command"]
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``rotomorph sweep``."""
+    p.add_argument("sweep", nargs="?", metavar="SWEEP.toml")
+    p.add_argument("-o", "--output", metavar="DIR", help="sweep folder (created; resumable)")
+    p.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on a Dask scheduler")
+    p.add_argument("--workers", type=int, help="local worker processes (default: CPU count)")
+    p.add_argument("--plot", action="store_true", help="draw the sweep's figures in DIR/figures")
+    p.add_argument("--schema", action="store_true", help="print the sweep file's JSON Schema")
+
+
+class _Bar:
+    """A tqdm bar fed with :class:`~rotomorph.sweep.runner.SweepProgress` counts."""
+
+    def __init__(self) -> None:
+        self.bar: Any = None
+
+    def __call__(self, p: Any) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(
+                total=p.total,
+                initial=p.skipped,
+                desc="sweep",
+                unit="run",
+                disable=not sys.stderr.isatty(),
+                leave=False,
+                smoothing=0.1,
+            )
+        self.bar.set_postfix(ok=p.ok, failed=p.failed, remaining=p.remaining, refresh=False)
+        self.bar.update(p.done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run ``rotomorph sweep``; returns the exit code (bad input raises InvalidParameterError)."""
+    from rotomorph.sweep.spec import load_sweep, sweep_schema
+
+    if args.schema:
+        sys.stdout.write(json.dumps(sweep_schema(), indent=2) + "\n")
+        if args.sweep is None:
+            return 0
+    if args.sweep is None:
+        raise InvalidParameterError("SWEEP", "give SWEEP.toml (or --schema)")
+    if not args.output:
+        raise InvalidParameterError("-o/--output", "give the sweep folder")
+    path = Path(args.sweep)
+    if not path.is_file():
+        raise InvalidParameterError("SWEEP", f"{args.sweep}: no such file")
+    if args.scheduler is not None and args.workers is not None:
+        raise InvalidParameterError("--workers", "is for the local pool; drop it with --scheduler")
+    out = Path(args.output)
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise InvalidParameterError("-o/--output", f"{out.parent}: parent folder does not exist")
+    sweep = load_sweep(path)
+    from rotomorph.sweep.runner import run_sweep
+
+    bar = _Bar()
+    try:
+        result = run_sweep(sweep, out, scheduler=args.scheduler, workers=args.workers, progress=bar)
+    finally:
+        bar.close()
+    statuses = result.table.column("status").to_pylist()
+    counts = {s: statuses.count(s) for s in ("ok", "invalid", "failed")}
+    p = result.progress
+    sys.stdout.write(
+        f"wrote {result.table_path}: {len(statuses)} point(s), {p.total} run(s) "
+        f"({counts['ok']} ok, {counts['invalid']} invalid, {counts['failed']} failed); "
+        f"{p.ok + p.failed} computed now, {p.skipped} found finished, "
+        f"{result.wall_time:.1f} s\n"
+    )
+    if args.plot:
+        from rotomorph.sweep.figures import plot_sweep
+
+        figs = plot_sweep(
+            result.table, [q.column for q in sweep.parameters], sweep.outputs, out / "figures"
+        )
+        sys.stdout.write(f"wrote {len(figs)} figure(s) to {out / 'figures'}\n")
+    if result.lost:
+        sys.stderr.write(
+            f"rotomorph: error: {len(result.lost)} run(s) lost to a failed worker "
+            f"(first: {result.lost[0]}); run the same command again to finish them\n"
+        )
+        return 1
+    return 0

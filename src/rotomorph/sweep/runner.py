@@ -1,0 +1,292 @@
+"""Run a sweep on any ``concurrent.futures.Executor``: resumable, exactly once per run id.
+
+:func:`run_sweep` resolves every point to a :class:`~rotomorph.sweep.run.RunSpec`, drops the
+ids already finished in the folder (a set difference, so a restarted sweep only computes what is
+missing), submits the rest to an executor and stores each outcome as it arrives
+(:class:`~rotomorph.sweep.store.RunStore`), then writes the table. The executor is
+
+* by default a local process pool (``workers`` processes, forked from a server that has already
+  imported rotomorph);
+* ``scheduler="tcp://HOST:PORT"``: a :class:`dask.distributed.Client` connected to that
+  scheduler, through its ``get_executor()``;
+* any object with ``get_executor()`` (a Dask ``Client``; e.g. one of a dask-jobqueue
+  ``SLURMCluster``) or any ``concurrent.futures.Executor``.
+
+Tasks are submitted as ``executor.submit(evaluate, spec)``; with Dask the task key is a hash of
+the function and the spec (``pure=True``), so duplicate runs collapse inside one scheduler too.
+Results travel back to this process, which alone writes the folder (workers need no shared
+file system). A failed run is recorded with its error and the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import json
+import logging
+import os
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rotomorph.errors import InvalidParameterError
+from rotomorph.io.atomic import atomic_write_text
+from rotomorph.sweep.run import RunOutcome, RunSpec, execute_run, resolve_run
+from rotomorph.sweep.sampling import sample_points
+from rotomorph.sweep.spec import Sweep
+from rotomorph.sweep.store import RunStore
+from rotomorph.sweep.table import TABLE_FILE, build_table, write_table
+
+__all__ = ["SweepProgress", "SweepResult", "plan_sweep", "run_sweep"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SweepProgress:
+    """Counts reported after every finished run.
+
+    Attributes
+    ----------
+    total
+        Distinct runs of the sweep.
+    skipped
+        Runs already finished in the folder when the sweep started.
+    ok, failed
+        Runs finished in this session with status ``ok`` / ``invalid`` or ``failed``.
+    """
+
+    total: int
+    skipped: int
+    ok: int
+    failed: int
+
+    @property
+    def done(self) -> int:
+        """Finished runs, including those found finished."""
+        return self.skipped + self.ok + self.failed
+
+    @property
+    def remaining(self) -> int:
+        """Runs still to compute."""
+        return self.total - self.done
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """A finished sweep.
+
+    Attributes
+    ----------
+    folder
+        The sweep folder.
+    table
+        The results table (:mod:`rotomorph.sweep.table`), a :class:`pyarrow.Table`.
+    progress
+        Final counts.
+    wall_time
+        Seconds this call took.
+    lost
+        Runs the executor lost (worker crash), not recorded: run the sweep again to finish them.
+    """
+
+    folder: Path
+    table: Any
+    progress: SweepProgress
+    wall_time: float
+    lost: tuple[str, ...] = ()
+
+    @property
+    def complete(self) -> bool:
+        """Every run is finished (ok, invalid or failed)."""
+        return self.progress.remaining == 0
+
+    @property
+    def table_path(self) -> Path:
+        """The Parquet file."""
+        return self.folder / TABLE_FILE
+
+
+def plan_sweep(sweep: Sweep) -> tuple[list[dict[str, Any]], list[RunSpec]]:
+    """The sweep's points and one :class:`RunSpec` per point (same order)."""
+    points = sample_points(sweep)
+    return points, [resolve_run(sweep, p) for p in points]
+
+
+@contextlib.contextmanager
+def _executor(executor: Any, scheduler: str | None, workers: int | None) -> Iterator[cf.Executor]:
+    if executor is not None and scheduler is not None:
+        raise InvalidParameterError("scheduler", "give an executor or a scheduler, not both")
+    if executor is not None:
+        yield executor.get_executor() if hasattr(executor, "get_executor") else executor
+        return
+    if scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:  # pragma: no cover - optional dependency
+            raise InvalidParameterError(
+                "scheduler", "needs dask.distributed: pip install 'rotomorph[sweep]'"
+            ) from None
+        try:
+            client = Client(scheduler, timeout="20s")
+        except OSError as err:
+            raise InvalidParameterError(
+                "scheduler", f"cannot reach the Dask scheduler at {scheduler}: {err}"
+            ) from None
+        with client:
+            yield client.get_executor()
+        return
+    if workers is not None and workers < 1:
+        raise InvalidParameterError("workers", f"must be >= 1; got {workers}")
+    with cf.ProcessPoolExecutor(
+        max_workers=workers or os.cpu_count() or 1,
+        mp_context=_pool_context(),
+        initializer=_warm_worker,
+    ) as ex:
+        yield ex
+
+
+def _pool_context() -> Any:
+    """``fork`` (cheap: workers inherit the imports) while this process has one thread;
+    ``forkserver`` otherwise (forking a threaded process can deadlock)."""
+    import multiprocessing
+    import threading
+
+    if threading.active_count() == 1 and "fork" in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(["rotomorph.sweep.run"])
+    return ctx
+
+
+def _warm_worker() -> None:
+    """Pool initializer: load the solver's kernels before the first run (see ``_warm``)."""
+    import rotomorph.sweep._warm  # noqa: F401
+
+
+def _write_plan(store: RunStore, sweep: Sweep) -> None:
+    text = json.dumps(sweep.model_dump(mode="json"), indent=2, sort_keys=True)
+    atomic_write_text(store.folder / "sweep.json", text + "\n", fsync=store.fsync)
+
+
+def run_sweep(
+    sweep: Sweep,
+    folder: str | os.PathLike[str],
+    *,
+    executor: Any = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[SweepProgress], None] | None = None,
+    evaluate: Callable[[RunSpec], RunOutcome] = execute_run,
+    max_pending: int = 256,
+    fsync: bool = True,
+) -> SweepResult:
+    """Compute every run of ``sweep`` not yet finished in ``folder`` and write the table.
+
+    Parameters
+    ----------
+    sweep
+        The validated sweep (:func:`~rotomorph.sweep.spec.load_sweep`).
+    folder
+        Output folder (created if missing); finished runs found there are not recomputed.
+    executor
+        A ``concurrent.futures.Executor`` or a Dask ``Client`` (its ``get_executor()`` is
+        used); the caller keeps ownership (it is not shut down).
+    scheduler
+        Address of a Dask scheduler (``tcp://HOST:PORT``) to connect to instead.
+    workers
+        Processes of the default local pool (default: the CPU count).
+    progress
+        Called with a :class:`SweepProgress` at the start and after every finished run.
+    evaluate
+        The function computing one run (default :func:`~rotomorph.sweep.run.execute_run`); a
+        replacement must be picklable (module-level) and return a :class:`RunOutcome`.
+    max_pending
+        Most runs submitted and not yet finished at a time.
+    fsync
+        Flush every record to disk before it counts as finished.
+
+    Raises
+    ------
+    InvalidParameterError
+        Another sweep holds the folder, or the scheduler cannot be reached.
+    """
+    t0 = time.perf_counter()
+    points, specs = plan_sweep(sweep)
+    unique = {s.run_id: s for s in specs}
+    with RunStore(folder, fsync=fsync) as store:
+        _write_plan(store, sweep)
+        done = store.finished() & set(unique)
+        todo = [unique[i] for i in dict.fromkeys(s.run_id for s in specs) if i not in done]
+        counts = {"ok": 0, "failed": 0}
+        total, skipped = len(unique), len(done)
+
+        def report() -> None:
+            if progress is not None:
+                progress(SweepProgress(total, skipped, counts["ok"], counts["failed"]))
+
+        def store_outcome(outcome: RunOutcome) -> None:
+            store.write(outcome.record, outcome.results)
+            counts["ok" if outcome.record["status"] == "ok" else "failed"] += 1
+            report()
+
+        report()
+        # known-invalid points need no worker
+        for spec in [s for s in todo if s.error is not None]:
+            store_outcome(evaluate(spec))
+        remote = [s for s in todo if s.error is None]
+        lost: list[str] = []
+        if remote:
+            with _executor(executor, scheduler, workers) as ex:
+                lost = _drain(ex, evaluate, remote, store_outcome, max(1, max_pending))
+        finished = store.finished()
+        records = {r: store.read(r) for r in unique if r in finished}
+        table = build_table(sweep, points, [s.run_id for s in specs], records)
+        write_table(table, store.folder / TABLE_FILE)
+    final = SweepProgress(total, skipped, counts["ok"], counts["failed"])
+    return SweepResult(Path(folder), table, final, time.perf_counter() - t0, tuple(lost))
+
+
+def _drain(
+    ex: cf.Executor,
+    evaluate: Callable[[RunSpec], RunOutcome],
+    specs: Sequence[RunSpec],
+    sink: Callable[[RunOutcome], None],
+    window: int,
+) -> list[str]:
+    """Submit ``specs`` (at most ``window`` pending), pass outcomes to ``sink``.
+
+    Returns the errors of runs the executor lost (a worker died, the pool broke); those runs
+    are not recorded, so running the sweep again computes them.
+    """
+    queue = iter(specs)
+    pending: dict[cf.Future[RunOutcome], RunSpec] = {}
+    lost: list[str] = []
+
+    def fill() -> None:
+        for spec in queue:
+            try:
+                pending[ex.submit(evaluate, spec)] = spec
+            except Exception as err:  # a broken pool refuses new work
+                lost.append(f"{spec.run_id[:12]}: {type(err).__name__}: {err}")
+                lost.extend(f"{s.run_id[:12]}: not submitted" for s in queue)
+                return
+            if len(pending) >= window:
+                return
+
+    fill()
+    while pending:
+        finished, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+        for fut in finished:
+            spec = pending.pop(fut)
+            try:
+                outcome = fut.result()
+            except Exception as err:  # the executor, not the run, failed
+                logger.warning("run %s lost: %s: %s", spec.run_id[:12], type(err).__name__, err)
+                lost.append(f"{spec.run_id[:12]}: {type(err).__name__}: {err}")
+                continue
+            sink(outcome)
+        fill()
+    return lost
