@@ -2,12 +2,14 @@
 
 ``grid`` takes the Cartesian product of every parameter's values (lists and ranges; the last
 parameter varies fastest). ``random`` and ``latin_hypercube`` draw ``samples`` points with the
-sweep's ``seed`` (NumPy's PCG64 and :class:`scipy.stats.qmc.LatinHypercube`): a uniform
+sweep's ``seed`` (NumPy's PCG64 generator): a uniform
 ``u`` in [0, 1) per parameter is mapped through the parameter's inverse distribution —
 ``low + u (high - low)`` (uniform), ``exp`` of that in logs (loguniform), the normal quantile
 (truncated to [low, high] when given) — or picks ``values[floor(u n)]`` of a list or range, so a
-Latin hypercube also stratifies discrete parameters. The same sweep file always gives the same
-points, in the same order.
+Latin hypercube also stratifies discrete parameters. The Latin hypercube (McKay, Beckman and
+Conover, Technometrics 21, 1979) puts, for every parameter, exactly one of the ``n`` points in
+each of ``n`` equal slices of [0, 1): ``u = (permutation(n) + U[0, 1)) / n`` per column. The
+same sweep file always gives the same points, in the same order.
 """
 
 from __future__ import annotations
@@ -38,12 +40,12 @@ def _from_unit(param: Parameter, u: np.ndarray) -> list[Any]:
         a, b = math.log(dist.low), math.log(dist.high)
         x = np.exp(a + u * (b - a))
     else:
-        from scipy.stats import norm
+        from scipy.special import ndtr, ndtri
 
         assert dist.mean is not None and dist.std is not None
-        lo = 0.0 if dist.low is None else norm.cdf(dist.low, dist.mean, dist.std)
-        hi = 1.0 if dist.high is None else norm.cdf(dist.high, dist.mean, dist.std)
-        x = norm.ppf(lo + u * (hi - lo), dist.mean, dist.std)
+        lo = 0.0 if dist.low is None else ndtr((dist.low - dist.mean) / dist.std)
+        hi = 1.0 if dist.high is None else ndtr((dist.high - dist.mean) / dist.std)
+        x = dist.mean + dist.std * ndtri(lo + u * (hi - lo))
     return [float(v) for v in x]
 
 
@@ -58,11 +60,10 @@ def sample_points(sweep: Sweep) -> list[dict[str, Any]]:
             for combo in itertools.product(*levels)
         ]
     n = int(sweep.sampling.samples or 0)
+    rng = np.random.default_rng(sweep.sampling.seed)
     if method == "random":
-        u = np.random.default_rng(sweep.sampling.seed).random((n, len(params)))
+        u = rng.random((n, len(params)))
     else:
-        from scipy.stats import qmc
-
-        u = qmc.LatinHypercube(d=len(params), seed=sweep.sampling.seed).random(n)
+        u = np.stack([(rng.permutation(n) + rng.random(n)) / n for _ in params], axis=1)
     columns = [_from_unit(p, u[:, j]) for j, p in enumerate(params)]
     return [{p.path: columns[j][i] for j, p in enumerate(params)} for i in range(n)]
