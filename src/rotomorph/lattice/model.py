@@ -226,7 +226,8 @@ def _build(
         directors=np.tile([0.0, 0.0, 1.0], (len(segments), 1)),
     )
     st = model.stencils
-    seg_expanding = np.array([lattice.segment_mode[k] == "expanding" for k in segments])
+    mode = np.asarray(lattice.segment_mode)  # a property built on every access: read it once
+    seg_expanding = mode[segments] == "expanding"
     rod_vertex = ~np.asarray(st.junction, dtype=bool)
     expanding = rod_vertex & seg_expanding[st.edge_e]
     for arr in (expanding, rod_vertex):
