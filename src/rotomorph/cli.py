@@ -139,7 +139,7 @@ def _check_materials(programs: list[Any]) -> None:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from rotomorph.io.designfile import design_schema
+    from rotomorph.io.designfile import design_schema, design_size
 
     if args.schema:
         _print(json.dumps(design_schema(), indent=2))
@@ -147,9 +147,19 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             return EXIT_OK
     if args.design is None:
         raise UsageError("validate: give DESIGN.toml (or --schema)")
+    # the same path as simulate and gcode: load_design (schema, ranges, size), then programs
+    from rotomorph.io.gcode import gcode_text
+
     design = _load_design(args.design)
     programs = design.to_programs()
     _check_materials(programs)
+    machine_note = f"; fits machine {args.machine or 'built-in default'}"
+    try:
+        gcode_text(programs, _machine(args, note=False), **design.gcode_options())
+    except MachineLimitError as err:
+        if args.machine is not None:
+            raise
+        machine_note = f"; note: not printable on the built-in default machine ({err})"
     parts = []
     if design.filaments:
         parts.append(f"{len(design.filaments)} filament(s)")
@@ -159,15 +169,36 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     length = sum(float(p.arc_length[-1]) for p in programs)
     _print(
         f"{args.design}: valid design '{design.name}': {', '.join(parts)}; "
-        f"{len(programs)} print program(s), {length:.1f} mm of filament; "
-        f"sha256 {design.sha256()[:12]}"
+        f"{len(programs)} print program(s), {length:.1f} mm of filament, "
+        f"{design_size(design).nodes} rod nodes; sha256 {design.sha256()[:12]}" + machine_note
     )
     return EXIT_OK
 
 
+def _machine(args: argparse.Namespace, *, note: bool = True) -> Any:
+    from rotomorph.io.machine import MachineProfile, load_machine_profile
+
+    if args.machine is None:
+        machine = MachineProfile(dialect=getattr(args, "dialect", None) or "aerotech")
+        if note:
+            sys.stderr.write(
+                "rotomorph: note: no --machine given; using the built-in default machine "
+                f"'{machine.name}' (envelope {list(machine.envelope_max)} mm, max feed "
+                f"{machine.max_feed:g} mm/s, max rotation {machine.max_rotation:g} rad/s); "
+                "stated in the header\n"
+            )
+        return machine
+    machine = load_machine_profile(_existing_file(args.machine, "--machine"))
+    dialect = getattr(args, "dialect", None)
+    if dialect is not None and dialect != machine.dialect:
+        from dataclasses import replace
+
+        machine = replace(machine, dialect=dialect)
+    return machine
+
+
 def _cmd_gcode(args: argparse.Namespace) -> int:
     from rotomorph.io.gcode import write_gcode
-    from rotomorph.io.machine import MachineProfile, load_machine_profile
 
     design = _load_design(args.design)
     if not args.output:
@@ -177,20 +208,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise UsageError(f"-o/--output: {out.parent}: folder does not exist")
-    if args.machine is not None:
-        machine = load_machine_profile(_existing_file(args.machine, "--machine"))
-        if args.dialect is not None and args.dialect != machine.dialect:
-            from dataclasses import replace
-
-            machine = replace(machine, dialect=args.dialect)
-    else:
-        machine = MachineProfile(dialect=args.dialect or "aerotech")
-        sys.stderr.write(
-            "rotomorph: note: no --machine given; using the built-in default machine "
-            f"'{machine.name}' (envelope {list(machine.envelope_max)} mm, max feed "
-            f"{machine.max_feed:g} mm/s, max rotation {machine.max_rotation:g} rad/s); "
-            "stated in the header\n"
-        )
+    machine = _machine(args)
     programs = design.to_programs()
     _check_materials(programs)
     write_gcode(programs, out, machine, **design.gcode_options(), layer_cure_s=args.cure)
@@ -200,13 +218,22 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from rotomorph.simulate.design import simulate_design, step_count
+    from rotomorph.simulate.options import check_run_options
     from rotomorph.simulate.outputs import write_run
 
     design = _load_design(args.design)
-    if args.steps < 1:
-        raise UsageError(f"--steps: must be >= 1; got {args.steps}")
-    if args.spacing is not None and not args.spacing > 0:
-        raise UsageError(f"--spacing: must be > 0 mm; got {args.spacing}")
+    options = {
+        "steps": args.steps,
+        "start_temperature": args.start_temperature,
+        "temperature": args.temperature,
+        "spacing": args.spacing,
+        "actuation": args.actuation,
+    }
+    try:  # before any output folder exists; named as the user typed them
+        check_run_options("lattice" if design.lattice else "filaments", **options)
+    except InvalidParameterError as err:
+        flag = "--" + err.field.replace("_", "-")
+        raise UsageError(f"{flag}: {str(err).split(': ', 1)[1]}") from None
     with _output_folder(args.output, force=args.force) as tmp:
         with _progress(step_count(design, args.steps), "simulate") as bar:
             sim = simulate_design(
@@ -284,6 +311,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("validate", help="check a design file", description="Check a design file.")
     p.add_argument("design", nargs="?", metavar="DESIGN.toml")
     p.add_argument("--schema", action="store_true", help="print the design file's JSON Schema")
+    p.add_argument(
+        "--machine", metavar="PROFILE.toml", help="also check the G-code against this machine"
+    )
     p.set_defaults(func=_cmd_validate)
 
     p = sub.add_parser("gcode", help="write G-code for a design", description="Write G-code.")
@@ -303,14 +333,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("design", metavar="DESIGN.toml")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
     p.add_argument("--steps", type=int, default=8, help="heating steps (default 8)")
-    p.add_argument("--temperature", type=float, default=175.0, help="final temperature (°C)")
-    p.add_argument("--start-temperature", type=float, default=25.0, help="print temperature (°C)")
+    p.add_argument(
+        "--temperature", type=float, help="final temperature (°C, filaments; default 175)"
+    )
+    p.add_argument(
+        "--start-temperature", type=float, help="print temperature (°C, filaments; default 25)"
+    )
     p.add_argument("--spacing", type=float, help="filament vertex spacing override (mm)")
     p.add_argument(
         "--actuation",
-        default="swapped",
         choices=("literal", "swapped", "radius", "additive", "thermal"),
-        help="lattice actuation rule (default swapped; see rotomorph.lattice.actuation)",
+        help="lattice actuation rule (lattices; default swapped; see rotomorph.lattice.actuation)",
     )
     p.add_argument("--no-gif", action="store_true", help="skip the GIF")
     p.add_argument("--force", action="store_true", help="replace a non-empty OUT")

@@ -55,7 +55,7 @@ def test_paper_parameters_in_examples():
 def test_error_names_the_field_path_and_the_fix():
     with pytest.raises(InvalidDesignError) as info:
         parse_design(_filament(speed=-2))
-    assert str(info.value) == "filaments[0].segments[2].speed: must be > 0 mm/s; got -2"
+    assert str(info.value) == "filaments[0].segments[2].speed: must be >= 0.01 mm/s; got -2"
     assert info.value.field == "filaments[0].segments[2].speed"
 
 
@@ -156,3 +156,139 @@ def test_example_prints_on_a_default_machine(path):
     assert all(
         np.allclose(r.program.points, p.points, atol=1e-4) for r, p in zip(read, progs, strict=True)
     )
+
+
+# ----------------------------------------------------------------------------- robust input
+
+
+def _one(**fil):
+    return {
+        "schema_version": 1,
+        "filaments": [{"segments": [{"kind": "line", "length": 10.0}]} | fil],
+    }
+
+
+@pytest.mark.parametrize(
+    ("fil", "match"),
+    [
+        ({"speed": True}, r"filaments\[0\]\.speed: must be a number \(mm/s\); got True \(bool\)"),
+        ({"speed": "3"}, r"speed: must be a number \(mm/s\) without quotes; got '3'"),
+        ({"layer": True}, r"layer: must be a whole number; got True"),
+        ({"layer": 1.0}, r"layer: must be a whole number; got 1.0"),
+        ({"start": [0, 0, True]}, r"start\[2\]: must be a number"),
+        ({"start": [0, 0]}, r"start: .*3 numbers"),
+        ({"name": 5}, r"name: must be a text string"),
+    ],
+)
+def test_strict_types_no_coercion(fil, match):
+    with pytest.raises(InvalidDesignError, match=match):
+        parse_design(_one(**fil))
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        (_one(rotation=1e12), r"filaments\[0\]\.rotation: must be <= 1000 rad/s"),
+        (_one(radius=1e6), r"filaments\[0\]\.radius: must be <= 10 mm"),
+        (_one(speed=0), r"speed: must be >= 0.01 mm/s; got 0"),
+        (_one(speed=1e-9), r"speed: must be >= 0.01 mm/s"),
+        (_one(start=[1e12, 0, 0]), r"start\[0\]: must be <= 10000 mm"),
+        (_one(active_fraction=0), r"active_fraction: must be > 0"),
+        (_one(active_material="acrylate"), r"active_material: 'acrylate' is a passive material"),
+        (_one(passive_material="unobtainium"), r"passive_material: unknown material"),
+        (_one(spacing=20.0), r"filaments\[0\]: has 2 vertices .* needs >= 3"),
+        ({"schema_version": True, "lattice": {}}, r"schema_version: must be 1; got True"),
+        ({"schema_version": 1, "lattice": {"n": 1e20}}, r"lattice\.n: must be a whole number"),
+        ({"schema_version": 1, "lattice": {"n": 10**20}}, r"lattice\.n: must be <= 10000"),
+        ({"schema_version": 1, "nozzle": {"active_pressure": 1e9}, "lattice": {}}, "<= 1000 psi"),
+        (_one() | {"lattice": {}}, "not both; split it"),
+    ],
+)
+def test_absurd_values_are_refused(data, match):
+    with pytest.raises(InvalidDesignError, match=match):
+        parse_design(data)
+
+
+def test_oversized_design_is_refused_before_building_with_the_numbers():
+    from rotomorph.io.design_limits import MAX_NODES
+
+    with pytest.raises(InvalidDesignError) as info:
+        parse_design({"schema_version": 1, "lattice": {"n": 500}})
+    msg = str(info.value)
+    assert msg.startswith("lattice: too large: about 5,240,000 rod nodes")
+    assert f"the limit is {MAX_NODES:,} nodes" in msg and "GB of memory" in msg
+    long = _one(spacing=0.001)
+    long["filaments"][0]["segments"] = [{"kind": "line", "length": 9999.0}]
+    with pytest.raises(InvalidDesignError, match=r"filaments\[0\]: too large: about 9,999,001"):
+        parse_design(long)
+
+
+def test_node_estimate_matches_the_built_design():
+    from rotomorph.io.designfile import design_size
+
+    for path in EXAMPLES:
+        design = load_design(path)
+        if design.lattice is not None:
+            built = design.lattice.to_lattice().network.n_nodes
+        else:
+            built = sum(len(p.points) for p in design.to_programs())
+        assert design_size(design).nodes == built, path.stem
+
+
+@pytest.mark.parametrize(
+    ("blob", "match"),
+    [
+        ("schema_version = 1\nname = 'é'\n[lattice]\n".encode("latin-1"), "not UTF-8 text .*0xe9"),
+        (b"schema_version = 1\n[lattice]\nn = \xff\n", "not UTF-8 text"),
+        (b"\xff\xfe" + "schema_version = 1\n[lattice\n".encode("utf-16-le"), "not valid TOML"),
+        (b"schema_version = 1\n" + b"a = " + b"[" * 3000, "not valid TOML"),
+        (b"\x00\x01", "not valid TOML"),
+    ],
+)
+def test_undecodable_files_are_one_line_errors(tmp_path, blob, match):
+    path = tmp_path / "d.toml"
+    path.write_bytes(blob)
+    with pytest.raises(InvalidDesignError, match=match) as info:
+        load_design(path)
+    assert "\n" not in str(info.value) and info.value.field == str(path)
+
+
+def test_utf16_and_bom_files_are_read(tmp_path):
+    text = "schema_version = 1\nname = 'Größe'\n[lattice]\nn = 3\n"
+    for i, blob in enumerate((text.encode("utf-16"), b"\xef\xbb\xbf" + text.encode())):
+        (tmp_path / f"{i}.toml").write_bytes(blob)
+        assert load_design(tmp_path / f"{i}.toml").name == "Größe"
+
+
+def test_with_spacing_revalidates():
+    from rotomorph.io.designfile import with_spacing
+
+    design = parse_design(_one())
+    assert with_spacing(design, 0.5).filaments[0].spacing == 0.5
+    with pytest.raises(InvalidDesignError, match=r"spacing: must be >= 0.001 mm"):
+        with_spacing(design, 0.0)
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('[machine]\nmax_feed = "50"\n', r"max_feed.* wrong type str; got '50'"),
+        ("[machine]\nmax_feed = true\n", r"max_feed.* wrong type bool; got True"),
+        ("[machine]\nenvelope_min = [0, 0]\n", r"envelope_m"),
+        ("[machine\nmax_feed = 5\n", r"not valid TOML"),
+        ("[machine]\npressure_template = 'P{port} Q{psi:.3q}'\n", "not a valid template"),
+        ("[machine]\npressure_template = 'P{port} Q{psi} {'\n", "not a valid template"),
+        ("machine = 3\n", r"must be a table"),
+    ],
+)
+def test_bad_machine_profiles(tmp_path, text, match):
+    from rotomorph.errors import InvalidParameterError
+    from rotomorph.io.machine import load_machine_profile
+
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    with pytest.raises(InvalidParameterError, match=match):
+        load_machine_profile(path)
+    path.write_bytes("[machine]\nname = 'Fräse'\n".encode("latin-1"))
+    with pytest.raises(InvalidParameterError, match="not UTF-8"):
+        load_machine_profile(path)

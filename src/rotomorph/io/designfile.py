@@ -30,7 +30,13 @@ driven by at most one of ``rotation`` (ω, rad/s), ``rotation_number`` (ω*) or
 
 Errors name the field path and the fix, e.g.
 ``filaments[0].segments[2].speed: must be > 0 mm/s; got -2``, raised as
-:class:`~rotomorph.errors.InvalidDesignError`.
+:class:`~rotomorph.errors.InvalidDesignError` (the CLI exits with status 2). Types are strict:
+``speed = "3"`` or ``speed = true`` is an error, not a number; every numeric field has a
+physical range (:data:`rotomorph.io.design_limits.LIMITS`), and the design's size in rod nodes
+is estimated before anything is built and refused above
+:data:`~rotomorph.io.design_limits.MAX_NODES`. ``validate``, ``simulate`` and ``gcode`` all go
+through :func:`load_design`, so they accept exactly the same files. Every field, unit, range and
+error is listed in ``docs/design-files.md``.
 """
 
 from __future__ import annotations
@@ -43,29 +49,45 @@ from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
 import numpy as np
 import tomli_w
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from rotomorph.design.lattices import Lattice, sinusoidal_lattice
 from rotomorph.design.path import Arc, Line, Path, Polyline, Sinusoid, chain_segments
 from rotomorph.design.program import PrintProgram, active_side_angle
-from rotomorph.errors import InvalidDesignError
+from rotomorph.errors import InvalidDesignError, MaterialError
 from rotomorph.io.atomic import atomic_write_text
+from rotomorph.io.design_limits import (
+    LIMITS,
+    MAX_NODES,
+    SizeEstimate,
+    lattice_nodes,
+    segment_edges,
+    sinusoid_length,
+)
+from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
+from rotomorph.materials.material import get_material, known_materials
 
 if TYPE_CHECKING:
     from pydantic_core import ErrorDetails
-
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
 
 __all__ = [
     "SCHEMA_VERSION",
     "Design",
     "design_schema",
+    "design_size",
     "load_design",
     "parse_design",
+    "parse_design_bytes",
     "save_design",
+    "with_spacing",
 ]
 
 SCHEMA_VERSION: Final = 1
@@ -79,23 +101,65 @@ _UNITS = {
     "layer_height": "mm",
     "diameter": "mm",
     "rotation": "rad/s",
+    "start": "mm",
+    "origin": "mm",
+    "points": "mm",
+    "flip_length": "mm",
+    "interface_angle_deg": "deg",
+    "angle_deg": "deg",
+    "heading_deg": "deg",
+    "initial_nozzle_angle_deg": "deg",
     "active_pressure": "psi",
     "passive_pressure": "psi",
 }
-Speed = Annotated[float, Field(gt=0, allow_inf_nan=False, description="mm/s")]
-Length = Annotated[float, Field(gt=0, allow_inf_nan=False, description="mm")]
-Vec3 = tuple[float, float, float]
+
+
+def _ranged(kind: str, default: Any = ..., description: str = "", **kw: Any) -> Any:
+    """A pydantic Field bounded by ``LIMITS[kind]`` (unit in the description)."""
+    lim = LIMITS[kind]
+    lo = {"gt": lim.minimum} if lim.exclusive_min else {"ge": lim.minimum}
+    desc = f"{description} ({lim.unit})" if lim.unit and description else description or lim.unit
+    return Field(default, le=lim.maximum, description=desc or None, **lo, **kw)  # type: ignore[call-overload]
+
+
+def _as_tuple(value: Any) -> Any:
+    """TOML arrays are lists; a 3-vector field takes a list of exactly three numbers."""
+    if isinstance(value, list | tuple):
+        if len(value) != 3:
+            raise ValueError(f"must be an array of 3 numbers [x, y, z] (mm); got {list(value)!r}")
+        return tuple(value)
+    return value
+
+
+Speed = Annotated[float, _ranged("speed", description="print speed")]
+Length = Annotated[float, _ranged("extent", description="length")]
+Coordinate = Annotated[float, _ranged("coordinate")]
+Vec3 = Annotated[tuple[Coordinate, Coordinate, Coordinate], BeforeValidator(_as_tuple)]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    # strict: no bool/str -> number coercion (an int is still a valid float)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+def _check_material(name: str, kind: str) -> str:
+    try:
+        mat = get_material(name)
+    except MaterialError:
+        raise ValueError(
+            f"unknown material {name!r}; use one of {', '.join(known_materials())}"
+        ) from None
+    if mat.kind != kind:
+        article = "an" if kind == "active" else "a"
+        raise ValueError(f"{name!r} is a {mat.kind} material; give {article} {kind} one")
+    return name
 
 
 class _Control(_Model):
     speed: Speed | None = None
-    rotation: float | None = Field(None, description="nozzle rotation rate ω (rad/s)")
-    rotation_number: float | None = Field(None, description="ω* = Rω/v (dimensionless)")
-    interface_angle_deg: float | None = Field(None, description="α held constant (deg)")
+    rotation: float | None = _ranged("rotation", None, "nozzle rotation rate ω")
+    rotation_number: float | None = _ranged("rotation_number", None, "ω* = Rω/v, dimensionless")
+    interface_angle_deg: float | None = _ranged("angle_deg", None, "α held constant")
 
     @model_validator(mode="after")
     def _one_control(self) -> _Control:
@@ -119,7 +183,7 @@ class LineSegment(_Control):
 class ArcSegment(_Control):
     kind: Literal["arc"]
     radius: Length
-    angle_deg: float = Field(description="turn (deg), > 0 counter-clockwise")
+    angle_deg: float = _ranged("arc_angle_deg", ..., "turn, > 0 counter-clockwise")
 
     @model_validator(mode="after")
     def _turns(self) -> ArcSegment:
@@ -132,12 +196,14 @@ class SinusoidSegment(_Control):
     kind: Literal["sinusoid"]
     amplitude: Length
     wavelength: Length
-    periods: float = Field(1.0, gt=0)
+    periods: float = _ranged("periods", 1.0, "number of periods")
 
 
 class PolylineSegment(_Control):
     kind: Literal["polyline"]
-    points: list[Vec3] = Field(min_length=2, description="lab coordinates (mm)")
+    points: list[Vec3] = Field(
+        min_length=2, max_length=MAX_NODES, description="lab coordinates (mm)"
+    )
 
 
 SegmentModel = Annotated[
@@ -148,20 +214,61 @@ SegmentModel = Annotated[
 class Filament(_Control):
     """One filament: a chain of segments and how to print it."""
 
-    name: str = ""
+    name: str = Field("", max_length=200)
     speed: Speed = 3.0
     active_side: Literal["outer", "inner"] | None = None
-    flip_length: float = Field(0.0, ge=0, description="mm over which active-side flips turn")
+    flip_length: float = Field(
+        0.0, ge=0, le=LIMITS["extent"].maximum, description="mm over which active-side flips turn"
+    )
     start: Vec3 = (0.0, 0.0, 0.0)
-    heading_deg: float = 0.0
-    initial_nozzle_angle_deg: float = 0.0
-    spacing: Length = 0.1
-    radius: Length = 0.3
-    active_fraction: float = Field(0.5, ge=0, le=1)
-    active_material: str = Field("lce", min_length=1)
-    passive_material: str = Field("acrylate", min_length=1)
-    layer: int = Field(0, ge=0)
-    segments: list[SegmentModel] = Field(min_length=1)
+    heading_deg: float = _ranged("angle_deg", 0.0, "initial heading")
+    initial_nozzle_angle_deg: float = _ranged("angle_deg", 0.0, "initial nozzle angle")
+    spacing: float = _ranged("vertex_spacing", 0.1, "rod vertex spacing")
+    radius: float = _ranged("filament_radius", 0.3, "filament radius R")
+    active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
+    active_material: str = Field("lce", min_length=1, max_length=100)
+    passive_material: str = Field("acrylate", min_length=1, max_length=100)
+    layer: int = _ranged("layer", 0, "printed layer")
+    segments: list[SegmentModel] = Field(min_length=1, max_length=MAX_NODES)
+
+    @field_validator("active_material")
+    @classmethod
+    def _active_known(cls, name: str) -> str:
+        return _check_material(name, "active")
+
+    @field_validator("passive_material")
+    @classmethod
+    def _passive_known(cls, name: str) -> str:
+        return _check_material(name, "passive")
+
+    @model_validator(mode="after")
+    def _size(self) -> Filament:
+        nodes = self.node_count()
+        if nodes < 3:
+            raise ValueError(
+                f"has {nodes} vertices at spacing {self.spacing} mm; a filament needs >= 3: "
+                "make it longer or reduce spacing"
+            )
+        refusal = SizeEstimate(nodes).refusal()
+        if refusal:
+            raise ValueError(f"{refusal}; increase spacing or shorten the filament")
+        return self
+
+    def node_count(self) -> int:
+        """Rod vertices of this filament at its ``spacing`` (computed without building it)."""
+        edges = 0
+        for seg in self.segments:
+            if seg.kind == "polyline":
+                edges += len(seg.points) - 1
+                continue
+            if seg.kind == "line":
+                length = seg.length
+            elif seg.kind == "arc":
+                length = seg.radius * math.radians(abs(seg.angle_deg))
+            else:
+                length = sinusoid_length(seg.amplitude, seg.wavelength, seg.periods)
+            edges += segment_edges(length, self.spacing)
+        return edges + 1
 
     @model_validator(mode="after")
     def _side_excludes_rotation(self) -> Filament:
@@ -242,21 +349,47 @@ def _geometry(seg: Any) -> Any:
 class LatticeModel(_Model):
     """The paper's sinusoidal lattice (:func:`rotomorph.design.lattices.sinusoidal_lattice`)."""
 
-    n: int = Field(5, ge=2)
+    n: int = _ranged("lattice_n", 5, "branch nodes per side")
     spacing: Length = 5.0
-    amplitude: float = Field(1.25, ge=0, description="mm")
-    ghost_nodes: int = Field(10, ge=1)
+    amplitude: float = Field(
+        1.25, ge=0, le=LIMITS["extent"].maximum, description="sine amplitude A (mm)"
+    )
+    ghost_nodes: int = _ranged("ghost_nodes", 10, "rod nodes inside each edge")
     pattern: Literal["expanding", "contracting", "dome", "saddle", "custom"] = "expanding"
     edge_modes: list[Literal["expanding", "contracting"]] | None = None
     centre: Literal["central_cells", "interior"] = "central_cells"
-    layers: int = Field(3, ge=1)
-    layer_height: Length = 0.6
+    layers: int = _ranged("layers", 3, "printed layers")
+    layer_height: float = _ranged("layer_height", 0.6, "layer height")
     speed: Speed = 3.0
-    radius: Length = 0.3
-    active_fraction: float = Field(0.5, ge=0, le=1)
-    active_material: str = Field("lce", min_length=1)
-    passive_material: str = Field("acrylate", min_length=1)
+    radius: float = _ranged("filament_radius", 0.3, "filament radius R")
+    active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
+    active_material: str = Field("lce", min_length=1, max_length=100)
+    passive_material: str = Field("acrylate", min_length=1, max_length=100)
     origin: Vec3 = (0.0, 0.0, 0.0)
+
+    @field_validator("active_material")
+    @classmethod
+    def _active_known(cls, name: str) -> str:
+        return _check_material(name, "active")
+
+    @field_validator("passive_material")
+    @classmethod
+    def _passive_known(cls, name: str) -> str:
+        return _check_material(name, "passive")
+
+    @model_validator(mode="after")
+    def _size(self) -> LatticeModel:
+        refusal = SizeEstimate(self.node_count()).refusal()
+        if refusal:
+            raise ValueError(
+                f"{refusal} (n = {self.n}, ghost_nodes = {self.ghost_nodes}); reduce n or "
+                "ghost_nodes"
+            )
+        return self
+
+    def node_count(self) -> int:
+        """Rod nodes of the lattice (computed without building it)."""
+        return lattice_nodes(self.n, self.ghost_nodes)
 
     @model_validator(mode="after")
     def _custom(self) -> LatticeModel:
@@ -289,25 +422,39 @@ class LatticeModel(_Model):
 class Nozzle(_Model):
     """Nozzle and pressure set-points used when writing G-code."""
 
-    diameter: Length = 1.0
-    active_pressure: float = Field(30.0, ge=0, description="psi")
-    passive_pressure: float = Field(30.0, ge=0, description="psi")
+    diameter: float = _ranged("nozzle_diameter", 1.0, "nozzle diameter")
+    active_pressure: float = _ranged("pressure", 30.0, "active channel pressure")
+    passive_pressure: float = _ranged("pressure", 30.0, "passive channel pressure")
 
 
 class Design(_Model):
     """A validated design file (filaments and/or a lattice)."""
 
     schema_version: Literal[1] = SCHEMA_VERSION
-    name: str = ""
-    description: str = ""
+    name: str = Field("", max_length=200)
+    description: str = Field("", max_length=10_000)
     nozzle: Nozzle = Nozzle()
-    filaments: list[Filament] = Field(default_factory=list)
+    filaments: list[Filament] = Field(default_factory=list, max_length=10_000)
     lattice: LatticeModel | None = None
 
+    @field_validator("schema_version", mode="before")
+    @classmethod
+    def _version_is_int(cls, value: Any) -> Any:
+        if isinstance(value, bool):  # True == 1 in Python; not a version number
+            raise ValueError(f"must be {SCHEMA_VERSION}; got {value!r}")
+        return value
+
     @model_validator(mode="after")
-    def _not_empty(self) -> Design:
+    def _one_kind(self) -> Design:
         if not self.filaments and self.lattice is None:
             raise ValueError("a design needs [[filaments]] or a [lattice]")
+        if self.filaments and self.lattice is not None:
+            raise ValueError(
+                "a design holds [[filaments]] or one [lattice], not both; split it into two files"
+            )
+        refusal = design_size(self).refusal()
+        if refusal:
+            raise ValueError(f"{refusal} over all filaments; split the design or increase spacing")
         return self
 
     def to_programs(self) -> list[PrintProgram]:
@@ -331,6 +478,19 @@ class Design(_Model):
         return hashlib.sha256(blob.encode()).hexdigest()
 
 
+_TYPE_ERRORS: Final = {
+    "float_type": "a number",
+    "int_type": "a whole number",
+    "int_from_float": "a whole number",
+    "string_type": "a text string in quotes",
+    "list_type": "an array [...]",
+    "tuple_type": "an array of 3 numbers [x, y, z]",
+    "model_type": "a table",
+    "dict_type": "a table",
+    "bool_type": "true or false",
+}
+
+
 def _format_error(err: ErrorDetails) -> tuple[str, str]:
     loc: list[str] = []
     for part in err["loc"]:
@@ -341,7 +501,8 @@ def _format_error(err: ErrorDetails) -> tuple[str, str]:
         else:
             loc.append(("." if loc else "") + str(part))
     field = "".join(loc) or "<design>"
-    unit = _UNITS.get(str(err["loc"][-1]) if err["loc"] else "", "")
+    names = [str(part) for part in err["loc"] if isinstance(part, str)]
+    unit = _UNITS.get(names[-1] if names else "", "")
     ctx, kind, got = err.get("ctx", {}), err["type"], err.get("input")
     if kind in ("greater_than", "greater_than_equal", "less_than_equal", "less_than"):
         op = {
@@ -357,6 +518,10 @@ def _format_error(err: ErrorDetails) -> tuple[str, str]:
         msg = "unknown key; remove it or check its spelling (see design_schema())"
     elif kind == "missing":
         msg = "is required"
+    elif kind in _TYPE_ERRORS:
+        what = _TYPE_ERRORS[kind] + (f" ({unit})" if unit else "")
+        quoted = " without quotes" if isinstance(got, str) else ""
+        msg = f"must be {what}{quoted}; got {got!r} ({type(got).__name__})"
     else:
         msg = err["msg"].removeprefix("Value error, ") + (
             f"; got {got!r}" if kind != "value_error" and not isinstance(got, dict) else ""
@@ -387,13 +552,38 @@ def load_design(path: str | FilePath) -> Design:
     Raises
     ------
     InvalidDesignError
-        TOML syntax errors (``<file>``) and schema violations (field path and fix).
+        A file that is not UTF-8 (or UTF-16/32 with a byte-order mark) or larger than 4 MiB,
+        TOML syntax errors (field ``<file>``), and schema violations (field path and fix).
+    OSError
+        The file cannot be read.
     """
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidDesignError(str(path), f"is not valid TOML: {exc}") from None
+    return parse_design(read_toml(path, InvalidDesignError))
+
+
+def parse_design_bytes(data: bytes, name: str = "<design>") -> Design:
+    """Validate the bytes of a TOML design file (as :func:`load_design`, without a file)."""
+    return parse_design(decode_toml_bytes(data, name, InvalidDesignError))
+
+
+def design_size(design: Design) -> SizeEstimate:
+    """Rod nodes of ``design`` (all filaments, or the lattice), estimated before building it."""
+    nodes = sum(f.node_count() for f in design.filaments)
+    if design.lattice is not None:
+        nodes += design.lattice.node_count()
+    return SizeEstimate(nodes)
+
+
+def with_spacing(design: Design, spacing: float) -> Design:
+    """``design`` with every filament's vertex spacing set to ``spacing`` (mm), re-validated.
+
+    Raises
+    ------
+    InvalidDesignError
+        ``spacing`` out of range, or the design too large or too coarse at that spacing.
+    """
+    data = design.model_dump(mode="python")
+    for fil in data["filaments"]:
+        fil["spacing"] = spacing
     return parse_design(data)
 
 

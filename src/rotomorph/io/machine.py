@@ -24,11 +24,7 @@ from pathlib import Path as FilePath
 from typing import Any
 
 from rotomorph.errors import InvalidParameterError
-
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
+from rotomorph.io.tomlfile import read_toml
 
 __all__ = ["DIALECTS", "MachineProfile", "check_line", "load_machine_profile"]
 
@@ -195,7 +191,14 @@ class MachineProfile:
             raise _bad("passive_port", "must differ from active_port")
         for name in ("pressure_template", "uv_on_template", "uv_off_template"):
             check_line(f"machine profile key '{name}'", getattr(self, name))
-        names = {f[1] for f in string.Formatter().parse(self.pressure_template) if f[1]}
+        try:
+            names = {f[1] for f in string.Formatter().parse(self.pressure_template) if f[1]}
+            self.pressure_template.format(port=1, psi=1.0)
+        except (ValueError, KeyError, IndexError, AttributeError) as err:
+            raise _bad(
+                "pressure_template",
+                f"is not a valid template ({err}); write e.g. 'M800 P{{port}} Q{{psi:.3f}}'",
+            ) from None
         if names != {"port", "psi"}:
             raise _bad("pressure_template", f"must use exactly {{port}} and {{psi}}; got {names}")
         for name in ("uv_on_template", "uv_off_template"):
@@ -250,13 +253,17 @@ class MachineProfile:
 
 
 def load_machine_profile(path: str | FilePath) -> MachineProfile:
-    """Read a profile from a TOML file (a ``[machine]`` table or top-level keys)."""
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidParameterError(
-            str(path), f"is not a valid TOML machine profile: {exc}"
-        ) from None
-    profile = MachineProfile.from_dict(data.get("machine", data))
+    """Read a profile from a TOML file (a ``[machine]`` table or top-level keys).
+
+    Raises
+    ------
+    InvalidParameterError
+        Not UTF-8 (or UTF-16/32 with a BOM), not valid TOML, unknown keys, wrong types or
+        values out of range (one line naming the key).
+    """
+    data = read_toml(path)
+    table = data.get("machine", data)
+    if not isinstance(table, dict):
+        raise _bad("machine", f"must be a table [machine]; got {table!r}")
+    profile = MachineProfile.from_dict(table)
     return replace(profile, source=check_line("machine profile path", FilePath(path).name))

@@ -21,6 +21,7 @@ import rotomorph
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.analysis.curvature import network_relative_curvature_change
 from rotomorph.errors import InvalidDesignError
+from rotomorph.io.designfile import with_spacing
 from rotomorph.io.results import RunResults, to_jsonable
 from rotomorph.materials.natural import FilamentModel
 from rotomorph.simulate.filament import (
@@ -29,6 +30,7 @@ from rotomorph.simulate.filament import (
     FilamentSimulation,
     simulate_filament,
 )
+from rotomorph.simulate.options import check_run_options
 
 __all__ = ["DesignSimulation", "simulate_design", "step_count"]
 
@@ -121,13 +123,10 @@ def _simulate_filaments(
     start_temperature: float,
     temperature: float,
     model: FilamentModel | None,
-    spacing: float | None,
     progress: Progress | None,
 ) -> DesignSimulation:
     sims = []
     for i, fil in enumerate(design.filaments):
-        if spacing is not None:
-            fil = fil.model_copy(update={"spacing": spacing})
         program = fil.to_program()
         sims.append(
             simulate_filament(
@@ -248,11 +247,11 @@ def simulate_design(
     design: Any,
     *,
     steps: int = 8,
-    start_temperature: float = PRINT_TEMPERATURE,
-    temperature: float = ACTUATION_TEMPERATURE,
+    start_temperature: float | None = None,
+    temperature: float | None = None,
     model: FilamentModel | None = None,
     spacing: float | None = None,
-    actuation: str = "swapped",
+    actuation: str | None = None,
     progress: Progress | None = None,
 ) -> DesignSimulation:
     """Predicted shapes of a design (:class:`rotomorph.io.designfile.Design`) over heating.
@@ -264,14 +263,17 @@ def simulate_design(
     steps
         Heating steps; results hold ``steps + 1`` states.
     start_temperature, temperature
-        Ramp of the filaments (°C); lattices use their own actuation parameter.
+        Ramp of the filaments (°C; default 25 → 175 °C, range
+        :data:`rotomorph.simulate.options.TEMPERATURE_RANGE`). Refused for lattices, which
+        use their own actuation parameter.
     model
-        Filament modelling choices (default calibrated :class:`FilamentModel`).
+        Filament modelling choices (default calibrated :class:`FilamentModel`); filaments only.
     spacing
-        Override the filaments' vertex spacing (mm); coarser is faster.
+        Override the filaments' vertex spacing (mm; the design is re-validated); coarser is
+        faster. Filaments only.
     actuation
         Lattice actuation rule (:data:`rotomorph.lattice.actuation.ACTUATIONS`; default
-        ``"swapped"``, notes Q4).
+        ``"swapped"``). Refused for filaments.
     progress
         Called with the number of finished units (see :func:`step_count`).
 
@@ -279,6 +281,9 @@ def simulate_design(
     ------
     InvalidDesignError
         A design with both filaments and a lattice.
+    InvalidParameterError
+        An option that does not apply to the design, or out of range
+        (:func:`rotomorph.simulate.options.check_run_options`).
     ConvergenceError
         A solve failed.
     """
@@ -287,16 +292,28 @@ def simulate_design(
         raise InvalidDesignError(
             "lattice", "simulate handles filaments or a lattice, not both; split the design file"
         )
+    check_run_options(
+        "lattice" if design.lattice is not None else "filaments",
+        steps=steps,
+        start_temperature=start_temperature,
+        temperature=temperature,
+        spacing=spacing,
+        model=model,
+        actuation=actuation,
+    )
     if design.lattice is not None:
-        sim = _simulate_lattice(design, steps=steps, actuation=actuation, progress=progress)
+        sim = _simulate_lattice(
+            design, steps=steps, actuation=actuation or "swapped", progress=progress
+        )
     else:
+        if spacing is not None:
+            design = with_spacing(design, spacing)
         sim = _simulate_filaments(
             design,
             steps=steps,
-            start_temperature=start_temperature,
-            temperature=temperature,
+            start_temperature=PRINT_TEMPERATURE if start_temperature is None else start_temperature,
+            temperature=ACTUATION_TEMPERATURE if temperature is None else temperature,
             model=model,
-            spacing=spacing,
             progress=progress,
         )
     meta = dict(sim.metadata)

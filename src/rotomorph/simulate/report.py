@@ -183,8 +183,8 @@ def _filament(
         speed=3.0,
         active_side=sinusoid,  # type: ignore[arg-type]
         spacing=spacing,
-        segments=[  # type: ignore[list-item]
-            {"kind": "sinusoid", "amplitude": 1.25, "wavelength": 5.0, "periods": 4}
+        segments=[
+            {"kind": "sinusoid", "amplitude": 1.25, "wavelength": 5.0, "periods": 4}  # type: ignore[list-item]
         ],
     )
 

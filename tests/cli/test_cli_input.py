@@ -1,0 +1,85 @@
+"""Bad input on the command line: one-line errors, exit 2, nothing written, same as the API."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rotomorph.cli import EXIT_OK, EXIT_USAGE, main
+
+LATTICE = "schema_version = 1\n[lattice]\nn = {n}\n"
+FILAMENT = (
+    "schema_version = 1\n[[filaments]]\nspacing = 1.0\n"
+    'segments = [{ kind = "line", length = 10.0 }]\n'
+)
+
+
+def _error(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith("rotomorph: error: "), err
+    return err.removeprefix("rotomorph: error: ")
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "design.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "flags", "message"),
+    [
+        (LATTICE.format(n=3), ["--temperature", "150"], "--temperature: applies to filaments"),
+        (LATTICE.format(n=3), ["--start-temperature", "20"], "--start-temperature: applies"),
+        (LATTICE.format(n=3), ["--spacing", "0.5"], "--spacing: applies to filaments"),
+        (FILAMENT, ["--actuation", "thermal"], "--actuation: applies to lattices only"),
+        (FILAMENT, ["--temperature", "1e12"], r"--temperature: must lie in [-50, 300] °C"),
+        (FILAMENT, ["--temperature", "nan"], "--temperature: must be finite"),
+        (FILAMENT, ["--steps", "0"], "--steps: must be a whole number in [1, 10000]"),
+        (FILAMENT, ["--spacing", "0"], "spacing: must be >= 0.001 mm"),
+    ],
+)
+def test_options_that_do_not_apply_or_are_absurd_are_refused(
+    tmp_path, capsys, text, flags, message
+):
+    out = tmp_path / "out"
+    assert main(["simulate", str(_write(tmp_path, text)), "-o", str(out), *flags]) == EXIT_USAGE
+    assert message in _error(capsys)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["design.toml"]
+
+
+@pytest.mark.parametrize("command", ["validate", "simulate", "gcode"])
+@pytest.mark.parametrize(
+    ("blob", "message"),
+    [
+        ("schema_version = 1\nname = 'é'\n[lattice]\n".encode("latin-1"), "is not UTF-8 text"),
+        (LATTICE.format(n=500).encode(), "lattice: too large: about 5,240,000 rod nodes"),
+        (LATTICE.format(n="1e20").encode(), "lattice.n: must be a whole number"),
+        (FILAMENT.replace("spacing = 1.0", "speed = true").encode(), "speed: must be a number"),
+    ],
+)
+def test_every_command_refuses_the_same_designs(tmp_path, capsys, command, blob, message):
+    path = tmp_path / "design.toml"
+    path.write_bytes(blob)
+    out = tmp_path / ("out.gcode" if command == "gcode" else "out")
+    argv = [command, str(path)] + ([] if command == "validate" else ["-o", str(out)])
+    assert main(argv) == EXIT_USAGE
+    assert message in _error(capsys)
+    assert not out.exists()
+
+
+def test_validate_checks_a_machine_like_gcode(tmp_path, capsys):
+    design = _write(tmp_path, FILAMENT)
+    machine = tmp_path / "machine.toml"
+    machine.write_text("[machine]\nenvelope_max = [5.0, 5.0, 5.0]\n")
+    assert main(["validate", str(design)]) == EXIT_OK
+    assert "rod nodes" in capsys.readouterr().out
+    assert main(["validate", str(design), "--machine", str(machine)]) == EXIT_USAGE
+    assert "machine limits" in _error(capsys)
+    out = tmp_path / "x.gcode"
+    assert main(["gcode", str(design), "-o", str(out), "--machine", str(machine)]) == EXIT_USAGE
+    assert "machine limits" in _error(capsys)
+    machine.write_text('[machine]\nmax_feed = "50"\n')
+    assert main(["validate", str(design), "--machine", str(machine)]) == EXIT_USAGE
+    assert "max_feed" in _error(capsys)
