@@ -173,14 +173,17 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
         return {"filaments": shapes}, None
     from rotomorph.simulate.design import simulate_design
 
+    # simulate_design refuses options that do not apply: a lattice takes the actuation rule,
+    # filaments the temperatures, spacing and filament model
+    lattice = design.lattice is not None
     sim = simulate_design(
         design,
         steps=s["steps"],
-        start_temperature=s["start_temperature"],
-        temperature=s["temperature"],
-        model=model,
-        spacing=s["spacing"],
-        actuation=s["actuation"],
+        start_temperature=None if lattice else s["start_temperature"],
+        temperature=None if lattice else s["temperature"],
+        model=None if lattice else model,
+        spacing=None if lattice else s["spacing"],
+        actuation=s["actuation"] if lattice else None,
     )
     if sim.kind == "lattice":
         metrics: dict[str, Any] = {"lattice": lattice_metrics(sim)}
