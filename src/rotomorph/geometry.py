@@ -185,6 +185,36 @@ def pair_strains(
     return kappa1, kappa2, tau
 
 
+def curvature_increment(
+    te: FloatArray, tf: FloatArray, m1e: FloatArray, m1f: FloatArray, vector: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Material components of a curvature vector at vertex stencils, as the rod measures them.
+
+    A pointwise curvature ``vector`` K (1/mm, toward the side the rod bends to) at a vertex
+    with unit bisector b changes the curvature binormal per unit length by b × K; the rod
+    reads the components ``½(b × K)·(m2e + m2f)`` and ``-½(b × K)·(m1e + m1f)`` (the same
+    averaged frames as :func:`pair_strains`), so these are the natural-curvature increments
+    that make the rod's discrete curvature vector equal K.
+
+    Parameters
+    ----------
+    te, tf
+        Unit tangents of the incoming and outgoing edges ``(S, 3)``.
+    m1e, m1f
+        Their unit material directors ``(S, 3)``.
+    vector
+        Curvature vectors ``(S, 3)`` (1/mm).
+
+    Returns
+    -------
+    dkappa1, dkappa2
+        ``(S,)`` increments toward m1 and m2 (1/mm).
+    """
+    m2e, m2f = np.cross(te, m1e), np.cross(tf, m1f)
+    dkb = np.cross(unit(te + tf), vector)
+    return 0.5 * _dot(dkb, m2e + m2f), -0.5 * _dot(dkb, m1e + m1f)
+
+
 def polyline_strains(
     points: FloatArray, directors: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:

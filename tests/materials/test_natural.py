@@ -74,7 +74,10 @@ def test_rotated_filament_matches_closed_form_helix() -> None:
     x = nf.actuation
     assert dtau[0] > 0  # untwists the printed (negative) interface twist
     np.testing.assert_allclose(nf.twist, -0.25 / R + x * dtau[0], rtol=1e-6)
-    np.testing.assert_allclose(nf.curvature1, x * kappa[0, 0], rtol=1e-6)
+    # K_J toward the vertex normal, read in the two edges' frames (each turned by half the
+    # interface rotation dα of an edge): the rod's curvature vector is exactly K_J toward n
+    half = 0.5 * np.abs(np.diff(prog.interface_angle))
+    np.testing.assert_allclose(nf.curvature1, x * kappa[0, 0] * np.cos(half), rtol=1e-6)
     # directors rotate with the interface angle about the tangent: n = cos a z + sin a (t x z)
     a = prog.interface_angle
     expected = np.column_stack([np.zeros_like(a), -np.sin(a), np.cos(a)])

@@ -74,7 +74,11 @@ def _as_points(path: Path | FloatArray) -> FloatArray:
 def _interface_normals(points: FloatArray, nozzle_angle_edge: FloatArray) -> FloatArray:
     """Lab-frame interface normals ``(N-1, 3)`` of the extrudate on each edge (module notes)."""
     e = np.diff(points, axis=0)
-    t = e / np.linalg.norm(e, axis=1)[:, None]
+    return _laid_down(e / np.linalg.norm(e, axis=1)[:, None], nozzle_angle_edge)
+
+
+def _laid_down(t: FloatArray, nozzle_angle_edge: FloatArray) -> FloatArray:
+    """The nozzle's in-plane normal at angle α_n carried onto a filament along ``t``."""
     m = np.column_stack(
         [np.cos(nozzle_angle_edge), np.sin(nozzle_angle_edge), np.zeros_like(nozzle_angle_edge)]
     )
@@ -195,6 +199,24 @@ class PrintProgram:
         """Unit interface normals toward the active half, per edge ``(N-1, 3)`` (lab frame)."""
         mid = 0.5 * (self.nozzle_angle[1:] + self.nozzle_angle[:-1])
         return _interface_normals(self.points, mid)
+
+    @property
+    def vertex_interface_normals(self) -> FloatArray:
+        """Interface normals at the vertices ``(N, 3)`` (lab frame, unit).
+
+        The vertex nozzle angle carried onto the vertex tangent (bisector of the two edges;
+        the edge's own at the ends), projected perpendicular to it. The natural field samples
+        the active side here (midpoint rule on each vertex's Voronoi cell): a flip between
+        two vertices then acts as a step at the edge midpoint, the ideal sharp flip, whatever
+        the vertex spacing (:func:`rotomorph.materials.natural.natural_field`).
+        """
+        e = np.diff(self.points, axis=0)
+        te = e / np.linalg.norm(e, axis=1)[:, None]
+        t = np.concatenate([te[:1], te[:-1] + te[1:], te[-1:]])
+        t /= np.linalg.norm(t, axis=1)[:, None]
+        n = _laid_down(t, self.nozzle_angle)
+        n -= np.sum(n * t, axis=1)[:, None] * t
+        return n / np.linalg.norm(n, axis=1)[:, None]
 
     @property
     def interface_angle(self) -> FloatArray:

@@ -262,9 +262,13 @@ def _material(name: str, materials: Mapping[str, Material] | None, kind: str) ->
 
 
 def _check_handedness(k1: FloatArray, k2: FloatArray, tw: FloatArray, w: FloatArray) -> None:
-    """Warn when, on straight stretches, the printed twist opposes the director helix."""
+    """Warn when, on straight stretches, the printed twist opposes the director helix.
+
+    Vertices where the interface turns by more than π/4 (integrated) are flips of the active
+    side, not a resolved helix, and are left out.
+    """
     w_vertex = 0.5 * (w[:-1] + w[1:])
-    straight = (np.hypot(k1, k2) < 1e-9) & (np.abs(w_vertex) > 1e-9)
+    straight = (np.hypot(k1, k2) < 1e-9) & (np.abs(w_vertex) > 1e-9) & (np.abs(tw) < np.pi / 4)
     if np.any(straight):
         agree = np.sign(tw[straight]) == np.sign(w_vertex[straight])
         if np.mean(agree) < 0.5:
@@ -289,6 +293,40 @@ def continuous_sign(normals: FloatArray, tangents: FloatArray) -> FloatArray:
         flips = np.einsum("ij,ij->i", prev, normals[1:]) < 0.0
         sign[1:] = np.where(np.cumsum(flips) % 2 == 1, -1.0, 1.0)
     return sign
+
+
+def _vertex_increments(
+    program: Any,
+    t: FloatArray,
+    normals: FloatArray,
+    speed: FloatArray,
+    rot: FloatArray,
+    radius: float,
+    model: FilamentModel,
+    section: FilamentSection,
+    passive: Material,
+) -> tuple[FloatArray, FloatArray]:
+    """Full-actuation curvature vector ``(N-2, 3)`` and eigen-twist ``(N-2,)`` at the interior
+    vertices, sampled at the vertex (midpoint rule on its Voronoi cell).
+
+    The active side is the program's vertex interface normal (``vertex_interface_normals``;
+    the mean of the two edge normals for programs without it). Sampling at vertices makes a
+    flip between two vertices a step at the edge midpoint, the boundary of the two Voronoi
+    cells; sampling the edge's mean nozzle angle instead put the active side on top of the
+    filament over the whole flip edge, an out-of-plane curvature K_J·h per flip that changed
+    the shape with the vertex spacing h.
+    """
+    vn = getattr(program, "vertex_interface_normals", None)
+    if vn is None:
+        n_v = geometry.unit(normals[:-1] + normals[1:])
+    else:
+        n_v = np.asarray(vn, dtype=float)[1:-1]
+    omega_v = DIRECTOR_HELIX_SENSE * dimensionless_rotation(rot[1:-1], speed[1:-1], radius)
+    e_par, e_perp, eps_p = model.strains(speed[1:-1], passive)
+    _, kappa, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
+    tb = geometry.unit(t[:-1] + t[1:])
+    vec = kappa[:, :1] * n_v + kappa[:, 1:2] * np.cross(tb, n_v)
+    return vec, np.asarray(dtau, dtype=float).reshape(-1)
 
 
 def natural_field(
@@ -342,7 +380,7 @@ def natural_field(
     omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
     section = model.section(active, passive, radius, frac)
     e_par, e_perp, eps_p = model.strains(edge_speed, passive)
-    eps_c, kappa, dtau = section.natural_strains(omega_star, e_par, e_perp, eps_p)
+    eps_c, _, _ = section.natural_strains(omega_star, e_par, e_perp, eps_p)
 
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
@@ -352,13 +390,10 @@ def natural_field(
     # and would leave a stiffness-free hinge there); the side is carried by the sign
     sign = continuous_sign(normals, t)
     directors = sign[:, None] * normals
-    kappa = sign[:, None] * kappa
     k1, k2, tw, vor = geometry.polyline_strains(pts, directors)
     _check_handedness(k1, k2, tw, omega_star)
-
-    def at_vertices(a: FloatArray) -> FloatArray:
-        return 0.5 * (a[:-1] + a[1:])
-
+    vec, dtw = _vertex_increments(program, t, normals, speed, rot, radius, model, section, passive)
+    dk1, dk2 = geometry.curvature_increment(t[:-1], t[1:], directors[:-1], directors[1:], vec)
     lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     measure = model.strain_model.measure
     axial = x * eps_c
@@ -366,9 +401,9 @@ def natural_field(
     ones = np.ones(len(lengths))
     return NaturalField(
         directors=directors,
-        curvature1=k1 / vor + x * at_vertices(kappa[:, 0]),
-        curvature2=k2 / vor + x * at_vertices(kappa[:, 1]),
-        twist=tw / vor + x * at_vertices(dtau),
+        curvature1=k1 / vor + x * dk1,
+        curvature2=k2 / vor + x * dk2,
+        twist=tw / vor + x * dtw,
         voronoi_length=vor,
         rest_length=lengths * stretch,
         axial_strain=axial,
