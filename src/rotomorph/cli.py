@@ -291,6 +291,13 @@ def _cmd_paper(args: argparse.Namespace) -> int:
         f"wrote {args.output}/report.md and summary.json: {len(report.rows)} rows "
         f"in {report.wall_time:.0f} s"
     )
+    if report.summary.get("not_converged"):
+        sys.stderr.write(
+            "NOT CONVERGED to 1 % between two resolutions (see report.md): "
+            + "; ".join(report.summary["not_converged"])
+            + "\n"
+        )
+        return EXIT_OK if args.allow_unconverged else EXIT_FAILED
     return EXIT_OK
 
 
@@ -367,6 +374,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
     p.add_argument("--quick", action="store_true", help="coarse and fast (for tests)")
     p.add_argument("--force", action="store_true", help="replace a non-empty OUT")
+    p.add_argument(
+        "--allow-unconverged",
+        action="store_true",
+        help="exit 0 even if a number is not converged to 1 %% (still reported)",
+    )
     p.set_defaults(func=_cmd_paper)
 
     from rotomorph.sweep.command import add_arguments, command

@@ -11,16 +11,26 @@ from PIL import Image
 
 from rotomorph.cli import EXIT_OK, main
 from rotomorph.materials import load_table
-from rotomorph.materials.calibrate import janus_curvature
-from rotomorph.simulate.report import calibrated_model
+from rotomorph.materials.calibrate import janus_curvature, paper_calibration
 
-KEYS = {"quantity", "condition", "measured", "spread", "predicted", "error", "calibration", "note"}
+KEYS = {
+    "quantity",
+    "condition",
+    "measured",
+    "spread",
+    "predicted",
+    "predicted_sd",
+    "error",
+    "calibration",
+    "converged",
+    "note",
+}
 
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("paper") / "out"
-    assert main(["paper", "-o", str(out), "--quick"]) == EXIT_OK
+    assert main(["paper", "-o", str(out), "--quick", "--allow-unconverged"]) == EXIT_OK
     return out
 
 
@@ -46,13 +56,16 @@ def test_summary_rows(report):
 @pytest.mark.slow
 def test_numbers_match_the_models(report):
     rows = json.loads((report / "summary.json").read_text())
-    model, _ = calibrated_model()
+    # leave-one-group-out: the curvature rows come from the fit without the curvature group
+    fit = paper_calibration(exclude=("janus_curvature",)).chosen
     table = load_table("janus_curvature")
-    expected = janus_curvature(model, table.x)
+    expected = janus_curvature(fit.model, table.x)
     got = [r for r in rows if r["quantity"] == "janus_curvature"]
     assert [r["condition"] for r in got] == list(table.condition)
-    np.testing.assert_allclose([r["predicted"] for r in got], expected, atol=1e-4)
-    assert sum(r["calibration"] for r in got) == 2
+    np.testing.assert_allclose([r["predicted"] for r in got], expected, atol=2e-3)
+    assert not any(r["calibration"] for r in got) and all(r["counted"] for r in got)
+    assert not any(r["calibration"] and r["counted"] for r in rows)
+    assert sum(r["counted"] for r in rows) >= 10
     # the composite coil at ω* = 0.06 is strongly contracted, the pure LCE rod is not
     comp = next(r for r in rows if r["quantity"] == "composite_length_L_over_L0")
     pure = next(r for r in rows if r["quantity"] == "pure_lce_length_L_over_L0")

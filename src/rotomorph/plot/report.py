@@ -24,6 +24,7 @@ def plot_measured_vs_predicted(
     predicted_label: str = "predicted",
     title: str = "",
     predicted_x: FloatArray | None = None,
+    out_of_sample: tuple[FloatArray, FloatArray, FloatArray] | None = None,
 ) -> Figure:
     """Measured means with error bars and the model's prediction on one axes.
 
@@ -45,6 +46,9 @@ def plot_measured_vs_predicted(
         Axes title.
     predicted_x
         Abscissae of ``predicted`` when they differ from ``x``.
+    out_of_sample
+        Optional ``(x, value, sd)`` of predictions made without these measurements (red
+        squares with ± sd bars), drawn next to the measured points.
     """
     xs = np.asarray(x, dtype=float).reshape(-1)
     m = np.asarray(measured, dtype=float).reshape(-1)
@@ -85,6 +89,20 @@ def plot_measured_vs_predicted(
         capsize=3,
         label=measured_label,
     )
+    if out_of_sample is not None:
+        ox, ov, osd = (np.asarray(a, dtype=float).reshape(-1) for a in out_of_sample)
+        if not ox.shape == ov.shape == osd.shape:
+            raise InvalidParameterError("out_of_sample", "x, value and sd must have one shape")
+        ax.errorbar(
+            ox * 1.03 if np.all(ox > 0) else ox,
+            ov,
+            yerr=osd,
+            fmt="s",
+            color="tab:red",
+            capsize=3,
+            ms=5,
+            label="predicted without these data (± sd)",
+        )
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     if title:
