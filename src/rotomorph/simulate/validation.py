@@ -87,20 +87,19 @@ def sinusoid_filament(side: str, spacing: float) -> Any:
     from rotomorph.io.designfile import Filament
 
     d = SINUSOID_DESIGN
+    segment = {
+        "kind": "sinusoid",
+        "amplitude": d["amplitude"],
+        "wavelength": d["wavelength"],
+        "periods": int(d["periods"]),
+    }
     return Filament(
         name="expanding" if side == "outer" else "contracting",
         speed=d["speed"],
         active_side=side,  # type: ignore[arg-type]
         flip_length=d["flip_length"],
         spacing=spacing,
-        segments=[  # type: ignore[list-item]
-            {
-                "kind": "sinusoid",
-                "amplitude": d["amplitude"],
-                "wavelength": d["wavelength"],
-                "periods": int(d["periods"]),
-            }
-        ],
+        segments=[segment],  # type: ignore[list-item]
     )
 
 

@@ -178,7 +178,7 @@ def filament_model(name: str) -> Any:
     if name == "empirical_threshold":
         from rotomorph.materials.calibrate import paper_calibration
 
-        return paper_calibration()[1].model
+        return paper_calibration().chosen.model
     raise InvalidParameterError("settings.filament_model", f"unknown model {name!r}")
 
 

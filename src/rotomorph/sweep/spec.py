@@ -194,8 +194,9 @@ class Settings(_Model):
     closed-form free helix of each filament's natural field at ``temperature`` (uniform
     filaments only, no lattices; milliseconds per run).
     ``filament_model`` picks the calibration: ``"warner_terentjev"`` (E_a/E_p fitted to the
-    Janus curvature at 3 mm/s) or ``"empirical_threshold"`` (threshold strain law fitted to
-    0.25 and 3 mm/s; see :func:`rotomorph.materials.calibrate.paper_calibration`).
+    Janus curvature at 3 mm/s) or ``"empirical_threshold"`` (threshold strain law and E_a/E_p
+    fitted jointly to the paper's filament data; see
+    :func:`rotomorph.materials.calibrate.paper_calibration`).
     """
 
     method: Literal["rod", "closed_form"] = "rod"
