@@ -158,8 +158,10 @@ def test_summary_round_trip(tmp_path, run):
     )
     summary = summarize(res)
     assert summary["n_steps"] == 4 and summary["n_nodes"] == 6 and summary["n_edges"] == 5
-    assert summary["final"]["area_ratio"] == pytest.approx(1.3)
-    assert summary["final"]["energy"] is None  # NaN becomes null: strict JSON
+    assert summary["end_of_ramp"]["area_ratio"] == pytest.approx(1.3)
+    assert summary["end_of_ramp"]["energy"] is None  # NaN becomes null: strict JSON
+    assert "final" not in summary  # the last state is a result only if it is physical
+    assert summary["physical"]["verdict"] == "unknown"  # nothing assessed: never "fine"
     path = write_summary(tmp_path / "summary.json", summary)
     text = path.read_text()
     assert "NaN" not in text

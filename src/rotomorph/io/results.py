@@ -1,16 +1,23 @@
 """One self-describing HDF5 file per run, plus a ``summary.json`` (DESIGN section 7).
 
-Layout (format ``rotomorph.results``, version 1)::
+Layout (format ``rotomorph.results``, version 2)::
 
-    /                       attrs: format, format_version, design (JSON), metadata (JSON)
+    /                       attrs: format, format_version, design (JSON), metadata (JSON),
+                                   physical ("yes" | "no" | "unknown"), physical_reason
     /topology/edges         (E, 2) int64       segment end-node indices
     /topology/branch        (N,)   bool        branch-node flags
     /steps/positions        (S, N, 3) float64  attrs: units = "mm"
     /steps/scalars/<name>   (S,)   float64     attrs: units  (actuation, energy, ...)
     /steps/fields/<name>    (S, ...) float64   attrs: units  (per-node or per-edge arrays)
+    /static/<name>          (N,...) or (E,...) attrs: units  (arrays that do not change over
+                                               the ramp: arc length, filament id, radius, ...)
+    /programs/<k>/<name>    print program k:   points (mm), speed (mm/s), nozzle_angle (rad);
+                                               attrs: name, radius (mm), active_fraction,
+                                               active_material, passive_material, layer
 
 Every dataset carries a ``units`` attribute; ``"1"`` means dimensionless. Files are written
-atomically (:mod:`rotomorph.io.atomic`).
+atomically (:mod:`rotomorph.io.atomic`). Version-1 files (no ``static``/``programs``) are read
+with those empty.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
@@ -35,7 +42,10 @@ __all__ = [
     "DEFAULT_UNITS",
     "FORMAT",
     "FORMAT_VERSION",
+    "PROGRAM_ATTRS",
+    "PROGRAM_UNITS",
     "RunResults",
+    "program_record",
     "read_results",
     "read_summary",
     "summarize",
@@ -45,7 +55,7 @@ __all__ = [
 ]
 
 FORMAT = "rotomorph.results"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 #: Units of the usual per-step scalars; any other name needs an entry in ``units``.
 DEFAULT_UNITS: Mapping[str, str] = {
@@ -61,6 +71,30 @@ DEFAULT_UNITS: Mapping[str, str] = {
     "characteristic_curvature": "1/mm",
     "end_to_end_ratio": "1",
     "converged": "1",
+    "stable": "1",
+    "min_clearance": "1",
+    "directors": "1",
+    "active_normal": "1",
+    "twist": "1/mm",
+    "curvature": "1/mm",
+    "arc_length": "mm",
+    "filament_id": "1",
+    "radius": "mm",
+    "interface_angle": "rad",
+    "active_fraction": "1",
+    "lattice_edge": "1",
+}
+
+#: Units of the arrays of a stored print program.
+PROGRAM_UNITS: Mapping[str, str] = {"points": "mm", "speed": "mm/s", "nozzle_angle": "rad"}
+#: Scalar attributes of a stored print program (name → unit, ``""`` for text).
+PROGRAM_ATTRS: Mapping[str, str] = {
+    "name": "",
+    "radius": "mm",
+    "active_fraction": "1",
+    "active_material": "",
+    "passive_material": "",
+    "layer": "1",
 }
 
 
@@ -85,7 +119,15 @@ class RunResults:
     units
         Unit of every scalar and field by name, and of ``"positions"``.
     metadata
-        Free-form run information (versions, run id, timings), JSON-compatible.
+        Free-form run information (versions, run id, timings, the physical-state verdict),
+        JSON-compatible.
+    static
+        Arrays that do not change over the ramp, by name: per node ``(N, ...)`` or per segment
+        ``(E, ...)`` (arc length, filament id, radius, interface angle, ...).
+    programs
+        The print programs: each a mapping with arrays ``points`` ``(n, 3)`` mm, ``speed``
+        ``(n,)`` mm/s, ``nozzle_angle`` ``(n,)`` rad and the scalars of
+        :data:`PROGRAM_ATTRS`.
     """
 
     design: Mapping[str, Any]
@@ -96,6 +138,8 @@ class RunResults:
     fields: Mapping[str, FloatArray] = field(default_factory=dict)
     units: Mapping[str, str] = field(default_factory=dict)
     metadata: Mapping[str, Any] = field(default_factory=dict)
+    static: Mapping[str, np.ndarray] = field(default_factory=dict)
+    programs: tuple[Mapping[str, Any], ...] = ()
 
     @property
     def n_steps(self) -> int:
@@ -186,6 +230,8 @@ def write_results(
     fields: Mapping[str, Any] | None = None,
     units: Mapping[str, str] | None = None,
     metadata: Mapping[str, Any] | None = None,
+    static: Mapping[str, Any] | None = None,
+    programs: Sequence[Mapping[str, Any]] = (),
 ) -> Path:
     """Write one run's results to an HDF5 file atomically and return its path.
 
@@ -208,7 +254,13 @@ def write_results(
     units
         Units by name; names in :data:`DEFAULT_UNITS` may be omitted, any other is required.
     metadata
-        JSON-compatible run information.
+        JSON-compatible run information; its ``physical`` entry (``{"verdict": "yes" | "no" |
+        "unknown", "reason": ...}``) is also written as root attributes.
+    static
+        Arrays without a step axis by name (per node or per segment); units as for fields.
+    programs
+        Print programs as mappings (see :class:`RunResults`), e.g. from
+        :func:`program_record`.
 
     Raises
     ------
@@ -218,7 +270,9 @@ def write_results(
     fields = dict(fields or {})
     e, b, pos, sc, fl = _validate(edges, branch, positions, scalars, fields)
     all_units = {"positions": "mm", **DEFAULT_UNITS, **dict(units or {})}
-    for name in [*sc, *fl]:
+    st = _validate_static(static or {}, len(b), len(e))
+    progs = [_validate_program(k, p) for k, p in enumerate(programs)]
+    for name in [*sc, *fl, *st]:
         if name not in all_units:
             raise InvalidParameterError(
                 "units", f"give a unit for {name!r} (use '1' for dimensionless)"
@@ -233,6 +287,9 @@ def write_results(
         h5.attrs["format_version"] = FORMAT_VERSION
         h5.attrs["design"] = design_json
         h5.attrs["metadata"] = _dumps(metadata or {})
+        verdict = dict((metadata or {}).get("physical") or {})
+        h5.attrs["physical"] = str(verdict.get("verdict", "unknown"))
+        h5.attrs["physical_reason"] = str(verdict.get("reason", "not assessed"))
         topo = h5.create_group("topology")
         topo.create_dataset("edges", data=e)
         topo.create_dataset("branch", data=b)
@@ -246,7 +303,69 @@ def write_results(
         for name, value in fl.items():
             d = g.create_dataset(name, data=value, compression="gzip", shuffle=True)
             d.attrs["units"] = all_units[name]
+        g = h5.create_group("static")
+        for name, value in st.items():
+            d = g.create_dataset(name, data=value)
+            d.attrs["units"] = all_units[name]
+        g = h5.create_group("programs")
+        for k, prog in enumerate(progs):
+            pg = g.create_group(f"{k:04d}")
+            for name, unit in PROGRAM_UNITS.items():
+                pg.create_dataset(name, data=prog[name]).attrs["units"] = unit
+            for name, unit in PROGRAM_ATTRS.items():
+                pg.attrs[name] = prog[name]
+                if unit:
+                    pg.attrs[f"{name}_units"] = unit
     return Path(path)
+
+
+def _validate_static(static: Mapping[str, Any], n: int, e: int) -> dict[str, np.ndarray]:
+    out = {}
+    for name, value in static.items():
+        _check_name("static", name)
+        v = np.asarray(value)
+        v = v.astype(np.int64) if v.dtype.kind in "iub" else v.astype(float)
+        if v.ndim < 1 or v.shape[0] not in (n, e):
+            raise InvalidParameterError(
+                f"static[{name!r}]", f"needs one row per node ({n}) or segment ({e}); got {v.shape}"
+            )
+        out[name] = v
+    return out
+
+
+def _validate_program(k: int, prog: Mapping[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    missing = [x for x in [*PROGRAM_UNITS, *PROGRAM_ATTRS] if x not in prog]
+    if missing:
+        raise InvalidParameterError(f"programs[{k}]", f"missing {', '.join(missing)}")
+    pts = np.asarray(prog["points"], dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise InvalidParameterError(f"programs[{k}].points", f"must be (n, 3) mm; got {pts.shape}")
+    out["points"] = pts
+    for name in ("speed", "nozzle_angle"):
+        v = np.asarray(prog[name], dtype=float).reshape(-1)
+        if v.shape != (len(pts),):
+            raise InvalidParameterError(f"programs[{k}].{name}", f"needs {len(pts)} values")
+        out[name] = v
+    for name, unit in PROGRAM_ATTRS.items():
+        out[name] = str(prog[name]) if not unit else float(prog[name])
+    return out
+
+
+def program_record(program: Any, name: str = "") -> dict[str, Any]:
+    """The stored form of a :class:`~rotomorph.design.program.PrintProgram` (see
+    :class:`RunResults`)."""
+    return {
+        "name": name,
+        "points": np.asarray(program.points, dtype=float),
+        "speed": np.asarray(program.speed, dtype=float),
+        "nozzle_angle": np.asarray(program.nozzle_angle, dtype=float),
+        "radius": float(program.radius),
+        "active_fraction": float(program.active_fraction),
+        "active_material": str(program.active_material),
+        "passive_material": str(program.passive_material),
+        "layer": float(getattr(program, "layer", 0)),
+    }
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -278,6 +397,17 @@ def read_results(path: str | os.PathLike[str]) -> RunResults:
         for name, ds in h5["steps/fields"].items():
             fields[name] = _frozen(ds[()])
             units[name] = str(ds.attrs["units"])
+        static = {}
+        for name, ds in h5.get("static", {}).items():
+            static[name] = _frozen(ds[()])
+            units[name] = str(ds.attrs["units"])
+        programs = []
+        for _, pg in sorted(h5.get("programs", {}).items()):
+            prog: dict[str, Any] = {name: _frozen(pg[name][()]) for name in PROGRAM_UNITS}
+            for name, unit in PROGRAM_ATTRS.items():
+                value = pg.attrs[name]
+                prog[name] = float(value) if unit else str(value)
+            programs.append(prog)
         return RunResults(
             design=json.loads(h5.attrs["design"]),
             edges=_frozen(h5["topology/edges"][()].astype(np.int64).reshape(-1, 2)),
@@ -287,21 +417,35 @@ def read_results(path: str | os.PathLike[str]) -> RunResults:
             fields=fields,
             units=units,
             metadata=json.loads(h5.attrs["metadata"]),
+            static=static,
+            programs=tuple(programs),
         )
 
 
 def summarize(results: RunResults) -> dict[str, Any]:
-    """A JSON-compatible summary: sizes, units and the first/last value of every scalar."""
-    return {
+    """A JSON-compatible summary: the physical-state verdict, per-filament results, sizes,
+    units and the first and end-of-ramp value of every scalar.
+
+    ``physical`` is ``metadata["physical"]`` when the run assessed its states, else
+    ``{"verdict": "unknown", ...}``; the last state is called ``end_of_ramp``, not "final":
+    it is a result only where ``physical.verdict`` is ``"yes"``.
+    """
+    meta = to_jsonable(results.metadata)
+    physical = meta.get("physical") or {"verdict": "unknown", "reason": "not assessed"}
+    out = {
         "format": FORMAT,
+        "physical": physical,
         "n_steps": results.n_steps,
         "n_nodes": int(results.positions.shape[1]),
         "n_edges": len(results.edges),
-        "final": {k: to_jsonable(v[-1]) for k, v in results.scalars.items()},
+        "end_of_ramp": {k: to_jsonable(v[-1]) for k, v in results.scalars.items()},
         "initial": {k: to_jsonable(v[0]) for k, v in results.scalars.items()},
         "units": dict(results.units),
-        "metadata": to_jsonable(results.metadata),
+        "metadata": meta,
     }
+    if "filaments" in meta:
+        out["filaments"] = meta["filaments"]
+    return out
 
 
 def write_summary(path: str | os.PathLike[str], summary: Mapping[str, Any]) -> Path:

@@ -6,8 +6,12 @@ Data arrays are written either inline-base64 ``binary`` (VTK's "binary" format: 
 byte count and the data, each base64-encoded, little-endian) or ``ascii``. ParaView's ASCII
 parser does not accept ``nan``; write binary when arrays may hold NaN (the default).
 
-``.pvd`` (Collection) lists one ``.vtp`` per time step with its ``timestep`` value, so ParaView
-plays the morphing as an animation. All files are written atomically.
+``.vtu`` (UnstructuredGrid) holds the same points with one line cell per network segment, so
+per-segment arrays (material directors, the interface normal toward the active half, radius)
+are cell data; unlike ``.vtp`` it is read by meshio as well as by ParaView and PyVista.
+
+``.pvd`` (Collection) lists one ``.vtp`` (or ``.vtu``) per time step with its ``timestep``
+value, so ParaView plays the morphing as an animation. All files are written atomically.
 """
 
 from __future__ import annotations
@@ -24,7 +28,14 @@ from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
 
-__all__ = ["network_lines", "write_pvd", "write_vtp", "write_vtp_series"]
+__all__ = [
+    "network_lines",
+    "write_pvd",
+    "write_vtp",
+    "write_vtp_series",
+    "write_vtu",
+    "write_vtu_series",
+]
 
 _VTK_TYPES = {
     np.dtype(np.float64): "Float64",
@@ -274,6 +285,118 @@ def write_vtp_series(
             pos[s],
             lines,
             point_data={k: v[s] for k, v in data.items()},
+            binary=binary,
+        )
+        entries.append((float(t[s]), name))
+    return write_pvd(target, entries)
+
+
+def write_vtu(
+    path: str | os.PathLike[str],
+    points: FloatArray,
+    segments: IntArray,
+    *,
+    point_data: Mapping[str, object] | None = None,
+    cell_data: Mapping[str, object] | None = None,
+    binary: bool = True,
+) -> Path:
+    """Write segments as VTK XML UnstructuredGrid line cells (``.vtu``), one cell per segment.
+
+    The format meshio, ParaView, VisIt and PyVista all read; per-segment arrays (directors,
+    the active side, radius) are cell data.
+
+    Parameters
+    ----------
+    path
+        Destination file; its folder must exist.
+    points
+        ``(N, 3)`` point coordinates (mm).
+    segments
+        ``(E, 2)`` node indices of the line cells.
+    point_data
+        Arrays ``(N,)`` or ``(N, k)`` by name.
+    cell_data
+        Arrays ``(E,)`` or ``(E, k)`` by name.
+    binary
+        Inline base64 (default) or ASCII data arrays.
+
+    Raises
+    ------
+    InvalidParameterError
+        Shapes that do not match, non-finite coordinates, or an invalid index.
+    """
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise InvalidParameterError("points", f"must have shape (N, 3) in mm; got {pts.shape}")
+    if not np.isfinite(pts).all():
+        raise InvalidParameterError("points", "must be finite")
+    n = len(pts)
+    seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
+    if len(seg) and (seg.min() < 0 or seg.max() >= n):
+        raise InvalidParameterError("segments", f"indices must lie in [0, {n - 1}]")
+    pd = {k: _as_data(k, v, n, "point_data") for k, v in (point_data or {}).items()}
+    cd = {k: _as_data(k, v, len(seg), "cell_data") for k, v in (cell_data or {}).items()}
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>\n',
+        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n',
+        "  <UnstructuredGrid>\n",
+        f'    <Piece NumberOfPoints="{n}" NumberOfCells="{len(seg)}">\n',
+    ]
+    for tag, arrays in (("PointData", pd), ("CellData", cd)):
+        out.append(f"      <{tag}>\n")
+        out += [_data_array(k, v, binary, "        ") for k, v in arrays.items()]
+        out.append(f"      </{tag}>\n")
+    out.append("      <Points>\n")
+    out.append(_data_array("Points", pts, binary, "        "))
+    out.append("      </Points>\n      <Cells>\n")
+    out.append(_data_array("connectivity", seg.reshape(-1), binary, "        "))
+    offsets = np.arange(2, 2 * len(seg) + 1, 2, dtype=np.int64)
+    out.append(_data_array("offsets", offsets, binary, "        "))
+    types = np.full(len(seg), 3, dtype=np.uint8)  # VTK_LINE
+    out.append(_data_array("types", types, binary, "        "))
+    out.append("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
+    return atomic_write_text(path, "".join(out))
+
+
+def write_vtu_series(
+    path: str | os.PathLike[str],
+    frames: FloatArray,
+    segments: IntArray,
+    *,
+    times: Sequence[float] | None = None,
+    point_data: Mapping[str, object] | None = None,
+    cell_data: Mapping[str, object] | None = None,
+    binary: bool = True,
+) -> Path:
+    """Write one ``.vtu`` per step (:func:`write_vtu`) next to a ``.pvd`` that plays them.
+
+    Parameters are those of :func:`write_vtp_series`; ``cell_data`` arrays are ``(S, E)`` or
+    ``(S, E, k)``. Returns the ``.pvd`` path.
+    """
+    pos = np.asarray(frames, dtype=float)
+    if pos.ndim != 3 or pos.shape[2] != 3:
+        raise InvalidParameterError("frames", f"must have shape (S, N, 3) in mm; got {pos.shape}")
+    steps = len(pos)
+    t = np.arange(steps, dtype=float) if times is None else np.asarray(times, dtype=float)
+    if t.shape != (steps,):
+        raise InvalidParameterError("times", f"must have one value per frame ({steps})")
+    pdata = {k: np.asarray(v) for k, v in (point_data or {}).items()}
+    cdata = {k: np.asarray(v) for k, v in (cell_data or {}).items()}
+    for what, data in (("point_data", pdata), ("cell_data", cdata)):
+        for k, v in data.items():
+            if v.shape[:1] != (steps,):
+                raise InvalidParameterError(f"{what}[{k!r}]", f"needs a leading axis of {steps}")
+    target = Path(path)
+    entries = []
+    for s in range(steps):
+        name = f"{target.stem}_{s:04d}.vtu"
+        write_vtu(
+            target.parent / name,
+            pos[s],
+            segments,
+            point_data={k: v[s] for k, v in pdata.items()},
+            cell_data={k: v[s] for k, v in cdata.items()},
             binary=binary,
         )
         entries.append((float(t[s]), name))

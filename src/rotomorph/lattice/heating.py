@@ -187,6 +187,11 @@ class HeatingResult:
         Seconds per step (0 for the printed row).
     lattice, model, actuation
         The design, its :class:`LatticeModel` and the actuation's name.
+    states
+        Rod state per step (row 0: the printed reference state); the material directors give
+        the Janus sides.
+    stable
+        Per step: the solver's stability verdict, ``None`` where it gave none.
     """
 
     parameter: FloatArray
@@ -205,6 +210,8 @@ class HeatingResult:
     lattice: Lattice
     model: LatticeModel
     actuation: str
+    states: tuple[State, ...] = ()
+    stable: tuple[bool | None, ...] = ()
 
     @property
     def final_area_ratio(self) -> float:
@@ -401,7 +408,14 @@ def heat_lattice(
         lattice=lattice,
         model=lm,
         actuation=act.name,
+        states=(lm.model.reference_state(), *(r.state for r in path.results)),
+        stable=(True, *(_stable_flag(r) for r in path.results)),
     )
+
+
+def _stable_flag(result: StaticResult) -> bool | None:
+    flag = getattr(result, "stable", None)
+    return None if flag is None else bool(flag)
 
 
 def free_edge_ratio(

@@ -94,15 +94,34 @@ def step_count(design: Any, steps: int) -> int:
     return len(design.filaments) * (steps + 1)
 
 
+#: A helix fit describes a shape when its rms residual is below this fraction of its radius.
+HELIX_FIT_RTOL = 0.1
+
+
+def _helix_describes(sim: FilamentSimulation) -> bool:
+    h = sim.helix
+    return h is not None and bool(h.rms_residual <= HELIX_FIT_RTOL * h.radius)
+
+
 def _filament_summary(sim: FilamentSimulation) -> dict[str, Any]:
+    # a shape label and a helix fit only where the fitted helix describes the shape (not on
+    # sinusoids or graded filaments, whose fits leave millimetre residuals)
+    fits = _helix_describes(sim)
+    straight = sim.morphology.value == "straight"
     out: dict[str, Any] = {
         "name": sim.name,
         "end_to_end_ratio": sim.final_ratio,
-        "morphology": sim.morphology.value,
+        "morphology": sim.morphology.value if fits or straight else None,
         "iterations": int(sim.iterations.sum()),
         "wall_time_s": round(sim.wall_time, 3),
     }
-    if sim.helix is not None:
+    if sim.helix is not None and not fits:
+        out["helix_fit_rejected"] = {
+            "rms_residual_mm": sim.helix.rms_residual,
+            "radius_mm": sim.helix.radius,
+            "reason": f"rms residual above {HELIX_FIT_RTOL:g} x the fitted radius",
+        }
+    if sim.helix is not None and fits:
         out["helix"] = {
             "radius_mm": sim.helix.radius,
             "pitch_mm": sim.helix.pitch,
@@ -154,8 +173,9 @@ def _simulate_filaments(
         "energy": np.sum([s.energy for s in sims], axis=0),
         "iterations": np.sum([s.iterations for s in sims], axis=0),
         "residual": np.max([s.residual for s in sims], axis=0),
-        "end_to_end_ratio": np.mean([s.end_to_end_ratio for s in sims], axis=0),
     }
+    if len(sims) == 1:  # several filaments: per filament only (a mean ratio describes none)
+        scalars["end_to_end_ratio"] = sims[0].end_to_end_ratio
     fields = {
         "end_to_end_ratio_per_filament": np.stack([s.end_to_end_ratio for s in sims], axis=1),
         "curvature": np.concatenate([s.curvature for s in sims], axis=1),

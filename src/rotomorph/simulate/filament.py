@@ -90,6 +90,14 @@ class FilamentSimulation:
         Closed-form free-helix prediction (notes 1.6) for a uniform natural field, else ``None``.
     wall_time
         Seconds spent.
+    states
+        Rod state per step ``(S,)`` (positions, frames): the material directors give the Janus
+        sides; step 0 is the printed reference state.
+    stable
+        Per step: ``True``/``False`` where the solver checked stability, ``None`` where it did
+        not (step 0, the stress-free printed state, is ``True``).
+    program
+        The print program simulated.
     """
 
     name: str
@@ -106,6 +114,9 @@ class FilamentSimulation:
     morphology: Morphology
     closed_form: Any
     wall_time: float
+    states: tuple[State, ...] = ()
+    stable: tuple[bool | None, ...] = ()
+    program: Any = None
 
     @property
     def final_ratio(self) -> float:
@@ -287,6 +298,8 @@ def simulate_filament(
         res = step.result
         positions[k], energy[k], residual[k] = res.positions, res.energy, res.residual
         iterations[k] = sum(n for w, n in iterations_at.items() if k - 1 < w <= k)
+    states = (state, *(step.result.state for step in path.steps))
+    stable = (True, *(_stable_flag(step.result) for step in path.steps))
     state = path.final.state
     ratio = np.array([end_to_end_ratio(p, printed) for p in positions])
     curvature = np.full((s, len(printed)), np.nan)
@@ -312,4 +325,13 @@ def simulate_filament(
         morphology=morph,
         closed_form=closed,
         wall_time=time.perf_counter() - t0,
+        states=states,
+        stable=stable,
+        program=program,
     )
+
+
+def _stable_flag(result: Any) -> bool | None:
+    """The solver's stability verdict of a result, ``None`` when it gave none."""
+    flag = getattr(result, "stable", None)
+    return None if flag is None else bool(flag)

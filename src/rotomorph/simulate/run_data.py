@@ -1,0 +1,232 @@
+"""What a run's files hold beyond positions: Janus sides, twist, the printed geometry, checks.
+
+:func:`describe_run` turns a :class:`~rotomorph.simulate.design.DesignSimulation` into the
+:class:`~rotomorph.io.results.RunResults` that is written, adding
+
+- per step: the material directors ``directors`` (m1, ``(S, E, 3)``), the interface normal
+  toward the active half ``active_normal`` (``(S, E, 3)``), the material twist per vertex
+  ``twist`` (``(S, N)``, 1/mm, NaN at chain ends and branch nodes) and the checks of
+  :mod:`rotomorph.io.validity` (``converged``, ``stable``, ``min_clearance``);
+- static arrays: ``arc_length`` per node (mm, printed, from each chain's start),
+  ``filament_id`` per node and segment (chain index; for lattices the lattice edge),
+  ``radius`` (mm), ``interface_angle`` (rad, printed, from the design's reference director),
+  ``active_fraction`` per segment and, for lattices, ``lattice_edge`` per segment;
+- the print programs (what the G-code is written from) and the physical-state verdict.
+
+The active side of a segment is fixed in its material frame: with β the angle of the printed
+interface normal n₀ from m1 toward m2 in the printed state, the deformed normal is
+n = cos β m1 + sin β m2.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.geometry import polyline_strains
+from rotomorph.io.results import RunResults, program_record, to_jsonable
+from rotomorph.io.validity import assess, verdict_record
+
+__all__ = ["active_normals", "chain_segments", "describe_run", "material_twist"]
+
+
+def chain_segments(edges: IntArray, chain: IntArray) -> IntArray:
+    """Segment index of each consecutive node pair of ``chain`` (−1 where none exists)."""
+    lookup = {(int(a), int(b)): j for j, (a, b) in enumerate(edges)}
+    lookup.update({(int(b), int(a)): j for j, (a, b) in enumerate(edges)})
+    return np.array([lookup.get((int(a), int(b)), -1) for a, b in itertools.pairwise(chain)])
+
+
+def active_normals(states: tuple[Any, ...], printed_normals: FloatArray) -> tuple[FloatArray, ...]:
+    """Material directors m1 and interface normals toward the active half per state.
+
+    Parameters
+    ----------
+    states
+        Rod states, the first the printed reference state.
+    printed_normals
+        Interface normals n₀ toward the active half per segment ``(E, 3)`` in the printed state.
+
+    Returns
+    -------
+    directors, normals
+        ``(S, E, 3)`` each.
+    """
+    m1_0, m2_0 = states[0].material_directors()
+    beta = np.arctan2(
+        np.einsum("ij,ij->i", printed_normals, m2_0), np.einsum("ij,ij->i", printed_normals, m1_0)
+    )
+    c, s = np.cos(beta)[:, None], np.sin(beta)[:, None]
+    m1s, ns = [], []
+    for st in states:
+        m1, m2 = st.material_directors()
+        m1s.append(m1)
+        ns.append(c * m1 + s * m2)
+    return np.stack(m1s), np.stack(ns)
+
+
+def material_twist(
+    positions: FloatArray, directors: FloatArray, edges: IntArray, chains: list[IntArray]
+) -> FloatArray:
+    """Material twist per node ``(S, N)`` (1/mm) along ``chains``; NaN at chain ends."""
+    out = np.full(positions.shape[:2], np.nan)
+    for chain in chains:
+        seg = chain_segments(edges, chain)
+        if len(chain) < 3 or (seg < 0).any():
+            continue
+        for k in range(len(positions)):
+            _, _, tw, vor = polyline_strains(positions[k][chain], directors[k][seg])
+            out[k, chain[1:-1]] = tw / vor
+    return out
+
+
+def _clearance(positions: FloatArray, edges: IntArray, diameter: float) -> FloatArray:
+    from rotomorph.lattice.heating import fused_pairs, segment_clearance
+
+    fused = fused_pairs(positions[0], edges, diameter)
+    return np.array([segment_clearance(p, edges, diameter, ignore=fused) for p in positions])
+
+
+def _combine(flags: FloatArray) -> FloatArray:
+    """Per step over filaments ``(F, S)``: the smallest value; NaN (unknown) if any filament is
+    unknown and no known value fails (is below 1)."""
+    if flags.size == 0:
+        return np.full(flags.shape[1:], np.nan)
+    with np.errstate(all="ignore"):
+        low = np.nanmin(np.where(np.isnan(flags), np.inf, flags), axis=0)
+    unknown = np.isnan(flags).any(axis=0)
+    return np.where(unknown & (low >= 1.0), np.nan, np.where(np.isinf(low), np.nan, low))
+
+
+def _filament_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, list]:
+    chains_meta = sim.metadata.get("chains", [])
+    static: dict[str, Any] = {
+        "arc_length": np.zeros(n),
+        "filament_id": np.zeros(n, dtype=np.int64),
+        "segment_filament_id": np.zeros(e, dtype=np.int64),
+        "radius": np.zeros(e),
+        "interface_angle": np.full(e, np.nan),
+        "active_fraction": np.zeros(e),
+    }
+    programs, chains = [], []
+    directors = np.full((sim.positions.shape[0], e, 3), np.nan)
+    normals = np.full_like(directors, np.nan)
+    clearance = np.full((len(sim.filaments), sim.positions.shape[0]), np.nan)
+    stable = np.full_like(clearance, np.nan)
+    edge_offset = 0
+    for i, fil in enumerate(sim.filaments):
+        start, stop = int(chains_meta[i]["start"]), int(chains_meta[i]["stop"])
+        nodes = np.arange(start, stop)
+        segs = np.arange(edge_offset, edge_offset + len(nodes) - 1)
+        edge_offset += len(nodes) - 1
+        chains.append(nodes)
+        program = getattr(fil, "program", None)
+        static["filament_id"][nodes] = i
+        static["segment_filament_id"][segs] = i
+        static["arc_length"][nodes] = np.r_[
+            0.0, np.cumsum(np.linalg.norm(np.diff(fil.printed, axis=0), axis=1))
+        ]
+        if fil.stable:
+            stable[i] = [np.nan if f is None else float(f) for f in fil.stable]
+        if program is None:
+            continue
+        programs.append(program_record(program, fil.name))
+        static["radius"][segs] = program.radius
+        static["active_fraction"][segs] = program.active_fraction
+        static["interface_angle"][segs] = program.interface_angle
+        if fil.states:
+            m1, nn = active_normals(fil.states, program.interface_normals)
+            directors[:, segs], normals[:, segs] = m1, nn
+        local = np.stack([np.arange(len(nodes) - 1), np.arange(1, len(nodes))], axis=1)
+        clearance[i] = _clearance(fil.positions, local, 2.0 * program.radius)
+    scalars = {"stable": _combine(stable), "min_clearance": _combine(clearance)}
+    fields = {"directors": directors, "active_normal": normals}
+    per_filament = [
+        {
+            "min_clearance_diameters": float(c[-1]) if np.isfinite(c[-1]) else None,
+            "physical": verdict_record(
+                assess({"converged": np.ones(len(c)), "stable": st, "min_clearance": c}, {}, len(c))
+            ),
+        }
+        for c, st in zip(clearance, stable, strict=True)
+    ]
+    return static, fields, scalars, programs, [chains, per_filament]
+
+
+def _lattice_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, list]:
+    from rotomorph.lattice.model import interface_normals
+
+    res = sim.lattice
+    lattice = res.lattice
+    edges = np.asarray(sim.edges)
+    chains = [np.asarray(c) for c in lattice.edge_chains]
+    lattice_edge = np.full(e, -1, dtype=np.int64)
+    arc = np.full(n, np.nan)
+    node_edge = np.full(n, -1, dtype=np.int64)
+    printed = np.asarray(sim.positions[0])
+    for j, chain in enumerate(chains):
+        seg = chain_segments(edges, chain)
+        lattice_edge[seg[seg >= 0]] = j
+        inner = chain[1:-1]
+        node_edge[inner] = j
+        arc[chain] = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(printed[chain], axis=0), axis=1))]
+    static = {
+        "arc_length": arc,
+        "filament_id": node_edge,
+        "lattice_edge": lattice_edge,
+        "radius": np.full(e, float(lattice.radius)),
+        "interface_angle": np.asarray(lattice.interface_angle, dtype=float),
+        "active_fraction": np.full(e, float(lattice.active_fraction)),
+    }
+    fields: dict[str, Any] = {}
+    if res.states:
+        m1, nn = active_normals(res.states, interface_normals(lattice))
+        fields = {"directors": m1, "active_normal": nn}
+    stable = (
+        np.array([np.nan if f is None else float(f) for f in res.stable])
+        if res.stable
+        else (np.full(sim.positions.shape[0], np.nan))
+    )
+    programs = [program_record(p, f"layer {p.layer}") for p in lattice.print_programs()]
+    return static, fields, {"stable": stable}, programs, [chains, []]
+
+
+def describe_run(sim: Any) -> RunResults:
+    """The self-describing :class:`RunResults` of a design simulation (module docstring)."""
+    base = sim.run_results()
+    n, e = base.positions.shape[1], len(base.edges)
+    if sim.kind == "lattice" and sim.lattice is not None:
+        static, fields, scalars, programs, (chains, per_fil) = _lattice_extras(sim, n, e)
+    else:
+        static, fields, scalars, programs, (chains, per_fil) = _filament_extras(sim, n, e)
+    if "directors" in fields:
+        fields["twist"] = material_twist(base.positions, fields["directors"], base.edges, chains)
+    s = base.n_steps
+    all_scalars = dict(base.scalars)
+    # every stored step comes from a converged solve (a failed one raises) or is the printed state
+    all_scalars.setdefault("converged", np.ones(s))
+    for k, v in scalars.items():
+        all_scalars.setdefault(k, np.asarray(v, dtype=float))
+    meta = dict(base.metadata)
+    meta.setdefault("contact", False)
+    verdicts = assess(all_scalars, meta, s)
+    meta["physical"] = verdict_record(verdicts)
+    if per_fil and "filaments" in meta:
+        meta["filaments"] = [
+            {**f, **extra} for f, extra in zip(meta["filaments"], per_fil, strict=False)
+        ]
+    units = dict(base.units)
+    units.setdefault("segment_filament_id", "1")
+    return replace(
+        base,
+        scalars=all_scalars,
+        fields={**base.fields, **fields},
+        static=static,
+        programs=tuple(programs),
+        units=units,
+        metadata=to_jsonable(meta),
+    )
