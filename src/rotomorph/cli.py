@@ -5,7 +5,8 @@ Commands::
     rotomorph validate DESIGN.toml            check a design file (or --schema: print the schema)
     rotomorph gcode DESIGN.toml -o FILE --dialect aerotech|rs274|marlin [--machine PROFILE.toml]
     rotomorph simulate DESIGN.toml -o OUT/    predicted shapes over heating (HDF5, figures, …)
-    rotomorph plot RESULT.h5 -o DIR           figures and GIF from a results file
+    rotomorph plot RESULT.h5 -o DIR           figures and movie from a results file
+    rotomorph view RUN [-o FILE.html]         interactive 3-D viewer of a run (needs plotly)
     rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
     rotomorph sweep SWEEP.toml -o DIR         parameter study (resumable; --scheduler for Dask)
 
@@ -100,8 +101,9 @@ def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
     if target.is_dir() and any(target.iterdir()) and not force:
         raise UsageError(f"-o/--output: {path}: folder is not empty; use --force to replace it")
     parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"-o/--output: {parent}: parent folder does not exist")
+    if parent.exists() and not parent.is_dir():
+        raise UsageError(f"-o/--output: {parent}: exists and is not a folder")
+    parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=parent))
     try:
         yield tmp
@@ -219,7 +221,8 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from rotomorph.simulate.design import simulate_design, step_count
     from rotomorph.simulate.options import check_run_options
-    from rotomorph.simulate.outputs import write_run
+    from rotomorph.simulate.outputs import run_line, write_run_results
+    from rotomorph.simulate.run_data import describe_run
 
     design = _load_design(args.design)
     options = {
@@ -245,34 +248,56 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                 actuation=args.actuation,
                 progress=bar.update,
             )
-        write_run(sim, tmp, gif=not args.no_gif)
-    final = sim.metadata.get("final") or {}
-    if sim.kind == "filaments":
-        desc = ", ".join(
-            f"{f['name']}: L/L0 = {f['end_to_end_ratio']:.3f} ({f['morphology']})"
-            for f in sim.metadata["filaments"]
-        )
-    else:
-        desc = (
-            f"area ratio {final.get('area_ratio', float('nan')):.3f}, "
-            f"Gaussian sign {final.get('gaussian_sign', float('nan')):+.0f}"
-        )
-    _print(f"wrote {args.output}: {desc}")
+        results = describe_run(sim)
+        write_run_results(results, tmp, movie=not args.no_movie)
+    _print(f"wrote {args.output}: {run_line(results)}")
     return EXIT_OK
 
 
-def _cmd_plot(args: argparse.Namespace) -> int:
+def _read_run(path: str, what: str) -> tuple[Path, Any]:
+    """A results file, given as the file or as the run folder holding ``results.h5``."""
     from rotomorph.io.results import read_results
+
+    p = Path(path)
+    if p.is_dir():
+        p = p / "results.h5"
+        if not p.exists():
+            raise UsageError(f"{what}: {path}: folder has no results.h5")
+    p = _existing_file(str(p), what)
+    try:
+        return p, read_results(p)
+    except OSError as err:
+        raise UsageError(f"{what}: {path}: not an HDF5 results file ({err})") from None
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
     from rotomorph.simulate.outputs import plot_run
 
-    path = _existing_file(args.result, "RESULT")
-    try:
-        results = read_results(path)
-    except OSError as err:
-        raise UsageError(f"RESULT: {args.result}: not an HDF5 results file ({err})") from None
-    with _output_folder(args.output, force=args.force) as tmp:
-        paths = plot_run(results, tmp, gif=not args.no_gif)
+    _, results = _read_run(args.result, "RESULT")
+    out = Path(args.output or "")
+    if not args.output:
+        raise UsageError("-o/--output: empty path; give a folder name")
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"-o/--output: {args.output}: exists and is not a folder")
+    paths = plot_run(results, out, movie=not args.no_movie)
     _print(f"wrote {len(paths)} file(s) to {args.output}")
+    return EXIT_OK
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from rotomorph.plot.viewer import write_viewer
+
+    path, results = _read_run(args.run, "RUN")
+    out = Path(args.output) if args.output else path.parent / "view.html"
+    if out.is_dir():
+        raise UsageError(f"-o/--output: {out}: is a folder; give an .html file name")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_viewer(results, out, field=args.field)
+    _print(f"wrote {out}")
+    if args.open:
+        import webbrowser
+
+        webbrowser.open(out.resolve().as_uri())
     return EXIT_OK
 
 
@@ -335,7 +360,7 @@ def build_parser() -> argparse.ArgumentParser:
         "simulate",
         help="predict shapes over heating",
         description="Predicted shapes over heating: results.h5, summary.json, figures/, "
-        "morphing.gif and a ParaView series in paraview/.",
+        "figures/morphing.mp4 and ParaView/VTK files in paraview/.",
     )
     p.add_argument("design", metavar="DESIGN.toml")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
@@ -352,18 +377,33 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("literal", "swapped", "radius", "additive", "thermal"),
         help="lattice actuation rule (lattices; default swapped; see rotomorph.lattice.actuation)",
     )
-    p.add_argument("--no-gif", action="store_true", help="skip the GIF")
+    p.add_argument("--no-movie", "--no-gif", action="store_true", help="skip the movie")
     p.add_argument("--force", action="store_true", help="replace a non-empty OUT")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser(
-        "plot", help="figures from a results file", description="Figures and GIF from RESULT.h5."
+        "plot",
+        help="figures from a results file",
+        description="Figures and movie from RESULT.h5 (or a run folder) into DIR, created if "
+        "missing; files of the same names are replaced, nothing else is touched.",
     )
     p.add_argument("result", metavar="RESULT.h5")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write")
-    p.add_argument("--no-gif", action="store_true", help="skip the GIF")
-    p.add_argument("--force", action="store_true", help="replace a non-empty DIR")
+    p.add_argument("--no-movie", "--no-gif", action="store_true", help="skip the movie")
     p.set_defaults(func=_cmd_plot)
+
+    p = sub.add_parser(
+        "view",
+        help="interactive 3-D viewer of a run (HTML)",
+        description="Write a self-contained HTML 3-D viewer of a run (a slider over the heating "
+        "ramp) and open it in the browser. Needs plotly: pip install 'rotomorph[html]'.",
+    )
+    p.add_argument("run", metavar="RUN", help="run folder or its results.h5")
+    p.add_argument("-o", "--output", metavar="FILE.html", help="default RUN/view.html")
+    p.add_argument("--field", default="janus",
+                   help="colour by 'janus' (active/passive halves) or a stored field")  # fmt: skip
+    p.add_argument("--no-open", dest="open", action="store_false", help="do not open a browser")
+    p.set_defaults(func=_cmd_view)
 
     p = sub.add_parser(
         "paper",

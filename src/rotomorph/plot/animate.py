@@ -1,9 +1,14 @@
-"""Animations of the morphing: one frame per actuation step, written as a GIF through Pillow."""
+"""Animations of the morphing: one frame per actuation step.
+
+:func:`write_movie` writes rendered frames as an MP4 through matplotlib's ffmpeg writer (a GIF
+through Pillow where no ffmpeg is installed); :func:`animate_gif` draws line networks into a
+small GIF.
+"""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +22,7 @@ from rotomorph.io.atomic import atomic_path
 from rotomorph.plot.figure import figure_to_rgb, new_figure
 from rotomorph.plot.shapes import scalar_colormap, scalar_norm, segment_values, set_equal_3d
 
-__all__ = ["animate_gif"]
+__all__ = ["animate_gif", "ffmpeg_available", "write_movie"]
 
 
 def animate_gif(
@@ -134,4 +139,80 @@ def animate_gif(
             loop=0,
             disposal=2,
         )
+    return target
+
+
+def ffmpeg_available() -> bool:
+    """Whether matplotlib finds an ``ffmpeg`` executable (for MP4)."""
+    from matplotlib import animation
+
+    return bool(animation.writers.is_available("ffmpeg"))
+
+
+def write_movie(
+    frames: Sequence[np.ndarray] | Callable[[int], np.ndarray],
+    count: int,
+    path: str | os.PathLike[str],
+    *,
+    seconds_per_frame: float = 0.6,
+    min_duration: float = 5.0,
+    hold_last: int = 2,
+) -> Path:
+    """Write rendered RGB frames as an MP4 (matplotlib's ffmpeg writer) or, without ffmpeg, a GIF.
+
+    Each frame is shown for ``seconds_per_frame`` (longer when needed to last ``min_duration``
+    seconds); the last one ``hold_last`` times longer. The MP4 is H.264 at 25 frames/s
+    (frames are repeated, never interpolated: every frame is a computed state).
+
+    Parameters
+    ----------
+    frames
+        ``count`` images ``(H, W, 3)`` uint8, all the same size, or a function returning
+        frame ``k`` (rendered on demand, so a long run does not hold every frame in memory).
+    count
+        Number of frames (>= 1).
+    path
+        Destination; its suffix is replaced by ``.mp4`` or ``.gif`` (whichever is written).
+    seconds_per_frame, min_duration, hold_last
+        Timing (s, s, frames).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    from matplotlib import animation
+
+    if count < 1:
+        raise InvalidParameterError("frames", "needs at least one frame")
+    if not (seconds_per_frame > 0 and min_duration >= 0):
+        raise InvalidParameterError("seconds_per_frame", "must be > 0 s")
+    get = frames if callable(frames) else (lambda k: frames[k])  # type: ignore[index]
+    shown = count + max(0, int(hold_last))
+    fps = 1.0 / max(seconds_per_frame, min_duration / shown)
+    first = np.asarray(get(0))
+    h, w = first.shape[0] - first.shape[0] % 2, first.shape[1] - first.shape[1] % 2
+    dpi = 100.0
+    fig = new_figure(w / dpi, h / dpi, dpi=dpi)
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_axis_off()
+    image = ax.imshow(first[:h, :w], interpolation="none", aspect="auto")
+    target = Path(path)
+    if ffmpeg_available():
+        target = target.with_suffix(".mp4")
+        writer: animation.AbstractMovieWriter = animation.FFMpegWriter(
+            fps=fps,  # type: ignore[arg-type]  # ffmpeg takes any rate
+            codec="h264",
+            extra_args=["-r", "25", "-pix_fmt", "yuv420p"],
+        )
+    else:  # pragma: no cover - depends on the machine
+        target = target.with_suffix(".gif")
+        writer = animation.PillowWriter(fps=fps)  # type: ignore[arg-type]
+    with atomic_path(target) as tmp, writer.saving(fig, str(tmp), dpi=dpi):
+        for k in range(count):
+            frame = first if k == 0 else np.asarray(get(k))
+            image.set_data(frame[:h, :w])
+            repeats = 1 + (max(0, int(hold_last)) if k == count - 1 else 0)
+            for _ in range(repeats):
+                writer.grab_frame()
     return target

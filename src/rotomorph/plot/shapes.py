@@ -67,13 +67,20 @@ def scalar_colormap(cmap: str | Colormap) -> Colormap:
 
 
 def scalar_norm(
-    values: FloatArray, vmin: float | None = None, vmax: float | None = None
+    values: FloatArray,
+    vmin: float | None = None,
+    vmax: float | None = None,
+    *,
+    floor: float = 1e-3,
 ) -> Normalize:
     """Colour limits for ``values``: the given ones, else robust automatic limits.
 
     Automatic limits span the 2nd to 98th percentile of the finite values (relative curvature
     changes blow up near inflection points, where κ_i → 0, and would wash out the rest), made
-    symmetric about 0 when the values take both signs. Values beyond are clipped.
+    symmetric about 0 when the values take both signs. Values beyond are clipped. Automatic
+    limits never come closer to 0 than ``floor`` (in the values' unit): a field that is zero
+    up to round-off (e.g. ±1e-7 on the flat printed lattice) is drawn in the colour map's
+    centre instead of being stretched into a red–blue pattern of noise.
     """
     finite = values[np.isfinite(values)]
     if vmin is None or vmax is None:
@@ -83,6 +90,8 @@ def scalar_norm(
             lo, hi = (float(q) for q in np.percentile(finite, [2.0, 98.0]))
             if lo < 0 < hi:
                 lo, hi = -max(-lo, hi), max(-lo, hi)  # symmetric about zero
+            if max(abs(lo), abs(hi)) < floor:
+                lo, hi = -floor, floor
         vmin = lo if vmin is None else vmin
         vmax = hi if vmax is None else vmax
     if vmax <= vmin:

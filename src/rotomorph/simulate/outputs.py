@@ -1,20 +1,27 @@
-"""Files of one simulation run: HDF5 results, summary, figures, ParaView series and a GIF.
+"""Files of one simulation run: HDF5 results, summary, figures, a movie and VTK files.
 
-:func:`write_run` writes a :class:`~rotomorph.simulate.design.DesignSimulation` into a folder;
-:func:`plot_run` draws the figures from a :class:`~rotomorph.io.results.RunResults` (so
-``rotomorph plot RESULT.h5`` re-creates exactly what ``rotomorph simulate`` drew). Every file is
-written atomically; the folder must exist.
+:func:`write_run` writes a :class:`~rotomorph.simulate.design.DesignSimulation` into a folder
+(created if missing); :func:`plot_run` draws the figures from a
+:class:`~rotomorph.io.results.RunResults` alone, so ``rotomorph plot RUN/results.h5 -o
+RUN/figures`` re-creates exactly what ``rotomorph simulate`` drew. Every file is written
+atomically.
 
 Folder layout::
 
-    results.h5              positions per step, scalars, fields, design, metadata
-    summary.json            sizes, first/last scalars, units, metadata
-    figures/shape_initial.png, figures/shape_final.png     3-D views (coloured)
-    figures/end_to_end_ratio.png                          filaments: L/L0 over temperature
-    figures/lattice_initial.png, figures/lattice_final.png lattices: top/side, Fig. 4 colouring
-    figures/lattice_metrics.png                           lattices: area, curvature vs strain
-    morphing.gif            the morphing, one frame per step
-    paraview/morphing.pvd   + morphing_0000.vtp …, point data per step
+    results.h5              positions per step, scalars, fields, static arrays, print programs
+    summary.json            verdict, per-filament results, first/last scalars, units, metadata
+    figures/shapes.png      shaded Janus tubes, one common scale (filaments: one panel each;
+                            lattices: printed, last physical step, end of ramp)
+    figures/ramp.png        filaments: states across the heating ramp
+    figures/end_to_end_ratio.png                filaments: L/L0 over temperature
+    figures/lattice_views.png                   lattices: top/side coloured by (κ − κ_i)/κ_i
+    figures/lattice_metrics.png                 lattices: area, curvature vs strain
+    figures/morphing.mp4    the morphing (GIF where no ffmpeg is installed)
+    paraview/morphing.pvd   + morphing_0000.vtp …: polylines with point data per step
+    paraview/segments.pvd   + segments_0000.vtu …: one line cell per segment, per-segment data
+                            (directors, active side, radius); readable by meshio
+
+States that are not physical are flagged in every figure title (:mod:`rotomorph.io.validity`).
 """
 
 from __future__ import annotations
@@ -26,9 +33,21 @@ from typing import Any
 import numpy as np
 
 from rotomorph.io.results import RunResults, summarize, write_results, write_summary
-from rotomorph.io.vtk import network_lines, write_vtp_series
+from rotomorph.io.validity import StepVerdict, assess, run_verdict
+from rotomorph.io.vtk import network_lines, write_vtp_series, write_vtu_series
 
-__all__ = ["colour_field", "plot_run", "write_run", "write_vtk"]
+__all__ = [
+    "colour_field",
+    "plot_run",
+    "run_line",
+    "write_run",
+    "write_run_results",
+    "write_vtk",
+]
+
+#: Tube radius (mm) when a results file does not store one.
+DEFAULT_RADIUS = 0.3
+_RED = "#b2182b"
 
 
 def colour_field(results: RunResults) -> tuple[str | None, str]:
@@ -53,7 +72,171 @@ def _labels(results: RunResults) -> list[str]:
     return [f"step {i}" for i in range(results.n_steps)]
 
 
-def _filament_figure(results: RunResults) -> Any:
+def _verdicts(results: RunResults) -> list[StepVerdict]:
+    return assess(results.scalars, results.metadata, results.n_steps)
+
+
+def _state_title(results: RunResults, k: int, verdicts: list[StepVerdict]) -> tuple[str, str]:
+    """Figure title of step ``k`` and its colour: never "final", the verdict always."""
+    last = results.n_steps - 1
+    where = "printed" if k == 0 else ("end of heating ramp" if k == last else f"step {k}/{last}")
+    v = verdicts[k] if k < last else run_verdict(verdicts)
+    colour = _RED if v.verdict == "no" else "k"
+    return f"{where}, {_labels(results)[k]} — {v.text()}", colour
+
+
+def _chains(results: RunResults) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, node indices, segment indices) per filament."""
+    out = []
+    edges = results.edges
+    for i, c in enumerate(results.metadata.get("chains", [])):
+        nodes = np.arange(int(c["start"]), int(c["stop"]))
+        segs = np.flatnonzero((edges[:, 0] >= nodes[0]) & (edges[:, 0] <= nodes[-1]))
+        out.append((str(c.get("name", f"filament {i}")), nodes, segs))
+    if not out:
+        out.append(("", np.arange(results.positions.shape[1]), np.arange(len(edges))))
+    return out
+
+
+def _segment_normals(results: RunResults, k: int, segs: np.ndarray) -> np.ndarray | None:
+    n = results.fields.get("active_normal")
+    if n is None:
+        return None
+    v = np.asarray(n[k][segs], dtype=float)
+    return v if np.isfinite(v).all() else None
+
+
+def _segment_radius(results: RunResults, segs: np.ndarray) -> np.ndarray | float:
+    r = results.static.get("radius")
+    if r is None or len(r) != len(results.edges):
+        return DEFAULT_RADIUS
+    v = np.asarray(r, dtype=float)[segs]
+    return v if np.all(np.isfinite(v) & (v > 0)) else DEFAULT_RADIUS
+
+
+def _fraction(results: RunResults, segs: np.ndarray) -> np.ndarray | float:
+    f = results.static.get("active_fraction")
+    if f is None or len(f) != len(results.edges):
+        return 0.5
+    v = np.asarray(f, dtype=float)[segs]
+    return v if np.all((v >= 0) & (v <= 1)) else 0.5
+
+
+def _filament_caption(results: RunResults, i: int, k: int) -> str:
+    """Panel title of filament ``i`` at step ``k``: name, L/L0 and, where it fits, the shape."""
+    chains = results.metadata.get("chains", [])
+    name = chains[i]["name"] if i < len(chains) else ""
+    ratios = results.fields.get("end_to_end_ratio_per_filament")
+    parts = [name] if name else []
+    if ratios is not None and i < ratios.shape[1]:
+        parts.append(f"L/L0 = {ratios[k, i]:.2f}")
+    info = results.metadata.get("filaments", [])
+    if k == results.n_steps - 1 and i < len(info):
+        helix = info[i].get("helix")
+        if helix:
+            parts.append(
+                f"{info[i].get('morphology', 'helix')}, fit rms {helix['rms_residual_mm']:.2g} mm"
+            )
+        verdict = (info[i].get("physical") or {}).get("verdict")
+        if verdict == "no":
+            parts.append("NOT PHYSICAL")
+    return "\n".join([parts[0], " · ".join(parts[1:])] if len(parts) > 1 else parts)
+
+
+def _filament_panels(results: RunResults, k: int, rows: list[int] | None = None) -> list[Any]:
+    from rotomorph.plot.tubes import TubePanel
+
+    panels = []
+    for i, (_, nodes, segs) in enumerate(_chains(results)):
+        if rows is not None and i not in rows:
+            continue
+        local = results.edges[segs] - nodes[0]
+        panels.append(
+            TubePanel(
+                positions=results.positions[k][nodes],
+                edges=local,
+                radius=_segment_radius(results, segs),
+                normals=_segment_normals(results, k, segs),
+                title=_filament_caption(results, i, k),
+                ghost=results.positions[0][nodes] if k > 0 else None,
+                active_fraction=_fraction(results, segs),
+            )
+        )
+    return panels
+
+
+def _lattice_panel(results: RunResults, k: int, title: str) -> Any:
+    from rotomorph.plot.tubes import TubePanel
+
+    segs = np.arange(len(results.edges))
+    return TubePanel(
+        positions=results.positions[k],
+        edges=results.edges,
+        radius=_segment_radius(results, segs),
+        normals=_segment_normals(results, k, segs),
+        title=title,
+        ghost=results.positions[0] if k > 0 else None,
+        active_fraction=_fraction(results, segs),
+    )
+
+
+def _lattice_steps(results: RunResults, verdicts: list[StepVerdict]) -> list[int]:
+    """Printed, the last step that is not known to fail (if earlier), and the end."""
+    last = results.n_steps - 1
+    ok = next((j - 1 for j, v in enumerate(verdicts) if v.verdict == "no"), last)
+    return sorted({0, max(ok, 0), last})
+
+
+def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
+    from rotomorph.plot.tubes import plot_tube_panels
+
+    last = results.n_steps - 1
+    title, colour = _state_title(results, last, verdicts)
+    if _kind(results) == "lattice":
+        panels = []
+        for k in _lattice_steps(results, verdicts):
+            v = verdicts[k]
+            head = "printed" if k == 0 else ("end of ramp" if k == last else "before the failure")
+            mark = (
+                ""
+                if v.verdict == "yes"
+                else ("\nNOT PHYSICAL" if v.verdict == "no" else "\nunverified")
+            )
+            panels.append(_lattice_panel(results, k, f"{head}, {_labels(results)[k]}{mark}"))
+        return plot_tube_panels(panels, suptitle=title, suptitle_colour=colour, columns=3)
+    panels = _filament_panels(results, last)
+    return plot_tube_panels(
+        panels, suptitle=title, suptitle_colour=colour, columns=min(len(panels), 4)
+    )
+
+
+def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
+    """Filaments (up to 4) across the ramp: 4 states each, one common scale."""
+    from rotomorph.plot.tubes import plot_tube_panels
+
+    last = results.n_steps - 1
+    steps = sorted({round(x) for x in np.linspace(0, last, min(4, last + 1))})
+    rows = list(range(min(4, len(_chains(results)))))
+    panels = []
+    for i in rows:
+        for k in steps:
+            p = _filament_panels(results, k, rows=[i])[0]
+            mark = {"no": " NOT PHYSICAL", "unknown": "", "yes": ""}[verdicts[k].verdict]
+            first = p.title.split("\n")[0]
+            label = f"{first}\n{_labels(results)[k]}{mark}"
+            panels.append(type(p)(**{**p.__dict__, "title": label}))
+    v = run_verdict(verdicts)
+    note = "" if v.verdict == "yes" else f" — {v.text()}"
+    return plot_tube_panels(
+        panels,
+        columns=len(steps),
+        panel_size=3.0,
+        suptitle=f"Heating ramp{note}",
+        suptitle_colour=_RED if v.verdict == "no" else "k",
+    )
+
+
+def _filament_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     from rotomorph.plot.figure import new_figure
 
     fig = new_figure(6.0, 4.2)
@@ -62,131 +245,253 @@ def _filament_figure(results: RunResults) -> Any:
     ratios = results.fields.get("end_to_end_ratio_per_filament")
     if ratios is None:
         ratios = results.scalars["end_to_end_ratio"][:, None]
-    chains = results.metadata.get("chains", [])
-    for j in range(ratios.shape[1]):
-        name = chains[j]["name"] if j < len(chains) else f"filament {j}"
-        ax.plot(t, ratios[:, j], marker="o", ms=3, label=name)
+    bad = np.array([v.verdict == "no" for v in verdicts])
+    for j, (name, _, _) in enumerate(_chains(results)):
+        ax.plot(t, ratios[:, j], marker="o", ms=3, label=name or f"filament {j}")
+        if bad.any():
+            ax.plot(t[bad], ratios[bad, j], "o", ms=7, mfc="none", mec=_RED)
+    if bad.any():
+        ax.plot([], [], "o", ms=7, mfc="none", mec=_RED, label="not physical")
     ax.set_xlabel("temperature (°C)" if "temperature" in results.scalars else "step")
     ax.set_ylabel("L/L0 (–)")
-    ax.set_title("End-to-end ratio over heating")
+    v = run_verdict(verdicts)
+    ax.set_title(
+        "End-to-end ratio over heating" + ("" if v.verdict == "yes" else f"\n{v.text()}"),
+        fontsize=10,
+        color=_RED if v.verdict == "no" else "k",
+    )
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    fig.set_layout_engine("constrained")
     return fig
 
 
-def _lattice_metrics_figure(results: RunResults) -> Any:
+def _lattice_metrics_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     from rotomorph.plot.figure import new_figure
 
     sc = results.scalars
-    fig = new_figure(10.0, 4.0)
+    fig = new_figure(10.0, 4.2)
     left, right = fig.subplots(1, 2)
-    x = sc.get("actuation", np.arange(results.n_steps, dtype=float))
+    x = sc.get("actuation", sc.get("temperature", np.arange(results.n_steps, dtype=float)))
+    bad = np.array([v.verdict == "no" for v in verdicts])
     left.plot(x, sc["area_ratio"], "o-", ms=3)
-    left.set_xlabel("actuation parameter x (–)")
+    right.plot(sc["edge_strain"], sc["characteristic_curvature"], "ko-", ms=3)
+    if bad.any():
+        left.plot(
+            x[bad], sc["area_ratio"][bad], "o", ms=8, mfc="none", mec=_RED, label="not physical"
+        )
+        right.plot(
+            sc["edge_strain"][bad],
+            sc["characteristic_curvature"][bad],
+            "o",
+            ms=8,
+            mfc="none",
+            mec=_RED,
+            label="not physical",
+        )
+        left.legend(fontsize=8)
+    left.set_xlabel("actuation parameter x (–)" if "actuation" in sc else "temperature (°C)")
     left.set_ylabel("A/A0 (–)")
     left.set_title("Projected area")
     left.grid(alpha=0.3)
-    right.plot(sc["edge_strain"], sc["characteristic_curvature"], "ko-", ms=3)
     right.set_xlabel("mean edge strain (–)")
     right.set_ylabel("√|k1 k2| (1/mm)")
     sign = sc.get("gaussian_sign", np.zeros(1))[-1]
-    right.set_title(f"Characteristic curvature (final Gaussian sign {sign:+.0f})")
+    right.set_title(f"Characteristic curvature (Gaussian sign at end {sign:+.0f})")
     right.grid(alpha=0.3)
+    v = run_verdict(verdicts)
+    if v.verdict != "yes":
+        fig.suptitle(v.text(), color=_RED if v.verdict == "no" else "k", fontsize=10)
+    fig.set_layout_engine("constrained")
     return fig
 
 
-def plot_run(
-    results: RunResults, folder: str | os.PathLike[str], *, gif: bool = True
-) -> list[Path]:
-    """Draw the run's figures (and GIF) into ``folder`` (created if missing); return the paths."""
-    from rotomorph.plot.animate import animate_gif
-    from rotomorph.plot.figure import save_figure
-    from rotomorph.plot.shapes import plot_lattice_views, plot_network_3d
+def _lattice_views(results: RunResults, verdicts: list[StepVerdict]) -> Any:
+    from rotomorph.plot.shapes import plot_lattice_views
 
-    out = Path(folder)
-    figs = out / "figures"
-    figs.mkdir(parents=True, exist_ok=True)
     name, label = colour_field(results)
-    values = None if name is None else results.fields[name]
-    pos, edges = results.positions, results.edges
-    paths = []
-    vmin: float | None
-    vmax: float | None
-    if values is not None:
-        finite = values[np.isfinite(values)]
-        lim = float(np.max(np.abs(finite))) if finite.size else 1.0
-        signed = finite.size and finite.min() < 0
-        vmin, vmax = (-lim, lim) if signed else (0.0, lim or 1.0)
-    else:
-        vmin = vmax = None
-    for tag, k in (("initial", 0), ("final", results.n_steps - 1)):
-        v = None if values is None else values[k]
-        fig = plot_network_3d(
-            pos[k],
-            edges,
-            v,
-            vmin=vmin,
-            vmax=vmax,
-            label=label,
-            title=f"{tag} ({_labels(results)[k]})",
-        )
-        paths.append(save_figure(fig, figs / f"shape_{tag}.png"))
-    if _kind(results) == "lattice":
-        for tag, k in (("initial", 0), ("final", results.n_steps - 1)):
-            v = None if values is None else values[k]
-            fig = plot_lattice_views(pos[k], edges, v, vmin=vmin, vmax=vmax, label=label, title=tag)
-            paths.append(save_figure(fig, figs / f"lattice_{tag}.png"))
-        paths.append(save_figure(_lattice_metrics_figure(results), figs / "lattice_metrics.png"))
-    else:
-        paths.append(save_figure(_filament_figure(results), figs / "end_to_end_ratio.png"))
-    if gif:
-        paths.append(
-            animate_gif(
-                pos,
-                edges,
-                out / "morphing.gif",
-                values=values,
-                labels=_labels(results),
-                view="3d",
-            )
-        )
-    return paths
-
-
-def write_vtk(results: RunResults, path: str | os.PathLike[str]) -> Path:
-    """ParaView series of the run (``.pvd`` + one ``.vtp`` per step) with its per-node fields."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    n = results.positions.shape[1]
-    data = {k: v for k, v in results.fields.items() if v.ndim == 2 and v.shape[1] == n}
-    times = results.scalars.get("temperature", results.scalars.get("actuation"))
-    return write_vtp_series(
-        target,
-        results.positions,
-        network_lines(results.edges, results.branch),
-        times=None if times is None else list(map(float, times)),
-        point_data=data,
+    last = results.n_steps - 1
+    values = None if name is None else results.fields[name][last]
+    title, _ = _state_title(results, last, verdicts)
+    return plot_lattice_views(
+        results.positions[last], results.edges, values, label=label, title=title
     )
 
 
-def write_run(sim: Any, folder: str | os.PathLike[str], *, gif: bool = True) -> list[Path]:
-    """Write every file of a simulation run into ``folder`` (must exist); return the paths."""
+def _movie(results: RunResults, verdicts: list[StepVerdict], path: Path) -> Path:
+    from rotomorph.plot.animate import write_movie
+    from rotomorph.plot.figure import figure_to_rgb
+    from rotomorph.plot.tubes import plot_tube_panels, tube_extent
+
+    lattice = _kind(results) == "lattice"
+
+    def panels(k: int) -> list[Any]:
+        if lattice:
+            return [_lattice_panel(results, k, "")]
+        return _filament_panels(results, k)
+
+    # a box per panel that holds the panel in every frame, so nothing rescales
+    per_step = [tube_extent(panels(k)) for k in range(results.n_steps)]
+    n_panels = len(per_step[0][0])
+    lo = [np.min([s[0][i] for s in per_step], axis=0) for i in range(n_panels)]
+    hi = [np.max([s[0][i] for s in per_step], axis=0) for i in range(n_panels)]
+    half = max(s[1] for s in per_step) + 0.5 * max(
+        float(np.max(h - l)) for l, h in zip(lo, hi, strict=True)
+    )
+    extent = ([0.5 * (l + h) for l, h in zip(lo, hi, strict=True)], half)
+    ncol = min(n_panels, 4)
+    size = max(4.0, 12.8 / ncol) if n_panels > 1 else 7.2
+
+    def frame(k: int) -> np.ndarray:
+        title, colour = _state_title(results, k, verdicts)
+        fig = plot_tube_panels(
+            panels(k),
+            extent=extent,
+            suptitle=title,
+            columns=ncol,
+            suptitle_colour=colour,
+            panel_size=size,
+            facets=10,
+            dpi=max(100.0, 1280.0 / (ncol * size)),
+        )
+        return figure_to_rgb(fig)
+
+    return write_movie(frame, results.n_steps, path)
+
+
+def plot_run(
+    results: RunResults, folder: str | os.PathLike[str], *, movie: bool = True
+) -> list[Path]:
+    """Draw the run's figures (and movie) into ``folder`` (created if missing).
+
+    Files of the same name are replaced (atomically); others in ``folder`` are left alone.
+    Returns the paths written.
+    """
+    from rotomorph.plot.figure import save_figure
+
     out = Path(folder)
-    results = sim.run_results()
+    out.mkdir(parents=True, exist_ok=True)
+    verdicts = _verdicts(results)
+    paths = [save_figure(_shapes_figure(results, verdicts), out / "shapes.png")]
+    if _kind(results) == "lattice":
+        paths.append(save_figure(_lattice_views(results, verdicts), out / "lattice_views.png"))
+        paths.append(
+            save_figure(_lattice_metrics_figure(results, verdicts), out / "lattice_metrics.png")
+        )
+    else:
+        paths.append(save_figure(_ramp_figure(results, verdicts), out / "ramp.png"))
+        paths.append(save_figure(_filament_figure(results, verdicts), out / "end_to_end_ratio.png"))
+    if movie:
+        paths.append(_movie(results, verdicts, out / "morphing.mp4"))
+    return paths
+
+
+def write_vtk(results: RunResults, folder: str | os.PathLike[str]) -> list[Path]:
+    """ParaView series of the run into ``folder``: polylines (``morphing.pvd`` + ``.vtp``) with
+    per-node data, and one line cell per segment (``segments.pvd`` + ``.vtu``, meshio-readable)
+    with per-segment data; static arrays are repeated in every step."""
+    target = Path(folder)
+    target.mkdir(parents=True, exist_ok=True)
+    n, e, s = results.positions.shape[1], len(results.edges), results.n_steps
+    point: dict[str, np.ndarray] = {}
+    cell: dict[str, np.ndarray] = {}
+    for name, v in results.fields.items():
+        if v.ndim >= 2 and v.shape[1] == n:
+            point[name] = v
+        if v.ndim >= 2 and v.shape[1] == e:
+            cell[name] = v
+    for name, v in results.static.items():
+        if len(v) == n and name not in point:
+            point[name] = np.broadcast_to(v, (s, *v.shape))
+        if len(v) == e and name not in cell:
+            cell[name] = np.broadcast_to(v, (s, *v.shape))
+
+    def named(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        # VTK arrays carry no unit attribute: dimensional ones name it, e.g. "twist [1/mm]"
+        out = {}
+        for name, v in arrays.items():
+            unit = results.units.get(name, "1")
+            out[name if unit in ("1", "") else f"{name} [{unit}]"] = v
+        return out
+
+    point, cell = named(point), named(cell)
+    times = results.scalars.get("temperature", results.scalars.get("actuation"))
+    t = None if times is None else list(map(float, times))
+    return [
+        write_vtp_series(
+            target / "morphing.pvd",
+            results.positions,
+            network_lines(results.edges, results.branch),
+            times=t,
+            point_data=point,
+        ),
+        write_vtu_series(
+            target / "segments.pvd",
+            results.positions,
+            results.edges,
+            times=t,
+            point_data=point,
+            cell_data=cell,
+        ),
+    ]
+
+
+def run_line(results: RunResults) -> str:
+    """One line for the command line: per-filament or lattice results and the verdict."""
+    v = run_verdict(_verdicts(results))
+    state = "end state " + v.text()
+    if _kind(results) == "lattice":
+        sc = results.scalars
+        parts = []
+        area = float(sc["area_ratio"][-1]) if "area_ratio" in sc else float("nan")
+        if np.isfinite(area) and area > 1e-3:
+            parts.append(f"area ratio {area:.3f}")
+        else:
+            parts.append("area ratio not meaningful (projected boundary loop folded onto itself)")
+        if "gaussian_sign" in sc:
+            parts.append(f"Gaussian sign {sc['gaussian_sign'][-1]:+.0f}")
+        return f"{', '.join(parts)}; {state}"
+    desc = []
+    for f in results.metadata.get("filaments", []):
+        text = f"{f['name']}: L/L0 = {f['end_to_end_ratio']:.3f}"
+        if f.get("helix"):
+            text += f" ({f.get('morphology', 'helix')})"
+        if (f.get("physical") or {}).get("verdict") == "no":
+            text += " NOT PHYSICAL"
+        desc.append(text)
+    return f"{', '.join(desc)}; {state}"
+
+
+def write_run(sim: Any, folder: str | os.PathLike[str], *, movie: bool = True) -> list[Path]:
+    """Write every file of a simulation run into ``folder`` (created if missing); return paths."""
+    from rotomorph.simulate.run_data import describe_run
+
+    return write_run_results(describe_run(sim), folder, movie=movie)
+
+
+def write_run_results(
+    results: RunResults, folder: str | os.PathLike[str], *, movie: bool = True
+) -> list[Path]:
+    """Write the files of a described run (:func:`~rotomorph.simulate.run_data.describe_run`)
+    into ``folder`` (created if missing); return the paths."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
     paths = [
         write_results(
             out / "results.h5",
-            design=sim.design,
-            edges=sim.edges,
-            branch=sim.branch,
-            positions=sim.positions,
-            scalars=sim.scalars,
-            fields=sim.fields,
-            units=sim.units,
+            design=results.design,
+            edges=results.edges,
+            branch=results.branch,
+            positions=results.positions,
+            scalars=results.scalars,
+            fields=results.fields,
+            units=results.units,
             metadata=results.metadata,
+            static=results.static,
+            programs=results.programs,
         )
     ]
     paths.append(write_summary(out / "summary.json", summarize(results)))
-    paths += plot_run(results, out, gif=gif)
-    paths.append(write_vtk(results, out / "paraview" / "morphing.pvd"))
+    paths += plot_run(results, out / "figures", movie=movie)
+    paths += write_vtk(results, out / "paraview")
     return paths

@@ -1,0 +1,451 @@
+"""Filaments drawn as shaded tubes with their active and passive halves in two colours.
+
+A segment of a printed Janus filament is a cylinder of radius R split by the interface: the
+half on the side of the interface normal n (toward the active ink) is active. :func:`tube_mesh`
+turns a network's segments into quadrilateral facets (``facets`` around each segment, mitred at
+ordinary nodes so neighbouring segments meet without gaps) and tells, per facet, whether it
+lies on the active side. With an active area fraction f ≠ ½ the interface is a chord at distance
+d from the axis, :math:`f = (θ - \\sin θ)/2π` with :math:`θ = 2\\arccos(d/R)`; a facet is
+active when its outward direction u satisfies :math:`u·n > d/R`.
+
+:func:`plot_tube_panels` draws one or more states side by side in 3-D on one common scale (the
+same millimetres per pixel in every panel), with Lambert–Phong shading, a faint ghost of the
+printed shape, a scale bar instead of axes, one title per panel and a legend outside the
+panels. Colours are either the Janus sides or a per-segment field with a colour bar.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from matplotlib.colors import Colormap, Normalize, to_rgb
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.errors import InvalidParameterError
+from rotomorph.plot.figure import new_figure
+
+__all__ = [
+    "ACTIVE_COLOUR",
+    "PASSIVE_COLOUR",
+    "TubePanel",
+    "interface_offset",
+    "plot_tube_panels",
+    "shade",
+    "tube_extent",
+    "tube_mesh",
+]
+
+#: Colour of the active (LCE) half.
+ACTIVE_COLOUR = "#d7301f"
+#: Colour of the passive half.
+PASSIVE_COLOUR = "#2b6cb0"
+#: Colour of segments whose side is unknown (no interface normal stored).
+UNKNOWN_COLOUR = "#8c8c8c"
+#: Above this many facets a picture falls back to coarser tubes (matplotlib draws each one).
+MAX_FACETS = 120_000
+
+
+def interface_offset(active_fraction: float) -> float:
+    """Distance d/R of the interface chord from the axis for an active area fraction f.
+
+    Solves :math:`f = (θ - \\sin θ)/2π`, :math:`θ = 2\\arccos(d/R)` by bisection; f = ½ → 0,
+    f → 0 → 1, f → 1 → −1.
+    """
+    f = float(active_fraction)
+    if not 0.0 <= f <= 1.0:
+        raise InvalidParameterError("active_fraction", f"must lie in [0, 1]; got {f}")
+    lo, hi = -1.0, 1.0  # d/R; the segment beyond d shrinks as d grows
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        theta = 2.0 * np.arccos(mid)
+        if (theta - np.sin(theta)) / (2.0 * np.pi) > f:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def _unit(v: FloatArray) -> FloatArray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(n > 0, n, 1.0)
+
+
+def _any_perpendicular(t: FloatArray) -> FloatArray:
+    helper = np.where(np.abs(t[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    return _unit(np.cross(t, helper))
+
+
+def _end_tangents(pos: FloatArray, edges: IntArray, t: FloatArray) -> FloatArray:
+    """Plane normal of each segment's two end rings ``(E, 2, 3)``: the bisector of the two
+    segments at an ordinary node (a mitre), the segment's own tangent elsewhere."""
+    n = len(pos)
+    incident: list[list[int]] = [[] for _ in range(n)]
+    for j, (a, b) in enumerate(edges):
+        incident[a].append(j)
+        incident[b].append(j)
+    out = np.repeat(t[:, None, :], 2, axis=1)
+    for node, inc in enumerate(incident):
+        if len(inc) != 2:
+            continue
+        e, f = inc
+        # orient both tangents along the walk e -> node -> f
+        te = t[e] if edges[e, 1] == node else -t[e]
+        tf = t[f] if edges[f, 0] == node else -t[f]
+        if float(te @ tf) < -0.5:  # a hairpin: a mitre would be degenerate
+            continue
+        mitre = _unit(te + tf)
+        for j in inc:
+            end = 0 if edges[j, 0] == node else 1
+            out[j, end] = mitre if float(mitre @ t[j]) >= 0 else -mitre
+    return out
+
+
+def tube_mesh(
+    positions: FloatArray,
+    edges: IntArray,
+    radius: float | FloatArray,
+    normals: FloatArray | None = None,
+    *,
+    facets: int = 16,
+    active_fraction: float | FloatArray = 0.5,
+) -> tuple[FloatArray, FloatArray, BoolArray | None, IntArray]:
+    """Quadrilateral facets of tubes around a network's segments.
+
+    Parameters
+    ----------
+    positions
+        Node positions ``(N, 3)`` (mm).
+    edges
+        Segments ``(E, 2)``.
+    radius
+        Tube radius (mm), scalar or per segment ``(E,)``.
+    normals
+        Interface normal toward the active half per segment ``(E, 3)`` (unit; need not be
+        exactly perpendicular to the segment), or ``None`` when the sides are unknown.
+    facets
+        Facets around each segment (>= 3; even numbers split a symmetric section exactly).
+    active_fraction
+        Active area fraction of the section, scalar or per segment.
+
+    Returns
+    -------
+    quads
+        ``(E·facets, 4, 3)`` facet corners (mm).
+    face_normals
+        ``(E·facets, 3)`` outward unit normals.
+    active
+        ``(E·facets,)`` True on the active side (``None`` without ``normals``).
+    segment
+        ``(E·facets,)`` index of each facet's segment.
+    """
+    pos = np.asarray(positions, dtype=float)
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if int(facets) != facets or facets < 3:
+        raise InvalidParameterError("facets", f"must be an integer >= 3; got {facets}")
+    k = int(facets)
+    m = len(e)
+    r = np.broadcast_to(np.asarray(radius, dtype=float), (m,))
+    if not np.all(np.isfinite(r) & (r > 0)):
+        raise InvalidParameterError("radius", "must be finite and > 0 mm")
+    a, b = pos[e[:, 0]], pos[e[:, 1]]
+    t = _unit(b - a)
+    ref = _any_perpendicular(t) if normals is None else np.asarray(normals, dtype=float)
+    if ref.shape != (m, 3):
+        raise InvalidParameterError("normals", f"must have shape ({m}, 3); got {ref.shape}")
+    ends = _end_tangents(pos, e, t)
+    centres = np.stack([a, b], axis=1)  # (E, 2, 3)
+    u = ref[:, None, :] - np.einsum("eij,ej->ei", ends, ref)[..., None] * ends
+    bad = np.linalg.norm(u, axis=-1) < 1e-9  # normal along the tangent: any perpendicular
+    if bad.any():
+        fallback = np.repeat(_any_perpendicular(t)[:, None, :], 2, axis=1)
+        u = np.where(bad[..., None], fallback, u)
+    u = _unit(u)
+    v = np.cross(ends, u)
+    phi = 2.0 * np.pi * np.arange(k + 1) / k
+    c, s = np.cos(phi), np.sin(phi)
+    # rings (E, 2, k+1, 3); each end ring lies in its mitre plane, on the circle of radius r
+    # measured in the segment's perpendicular plane (scaled so neighbours share the circle)
+    rings = centres[:, :, None, :] + r[:, None, None, None] * (
+        c[None, None, :, None] * u[:, :, None, :] + s[None, None, :, None] * v[:, :, None, :]
+    )
+    quads = quad_corners(rings)
+    mid_phi = phi[:-1] + np.pi / k
+    um = _unit(ref - np.einsum("ij,ij->i", t, ref)[:, None] * t)
+    um = np.where((np.linalg.norm(um, axis=1) < 1e-9)[:, None], _any_perpendicular(t), um)
+    vm = np.cross(t, um)
+    face_normals = (
+        np.cos(mid_phi)[None, :, None] * um[:, None, :]
+        + np.sin(mid_phi)[None, :, None] * vm[:, None, :]
+    ).reshape(m * k, 3)
+    segment = np.repeat(np.arange(m), k)
+    active = None
+    if normals is not None:
+        frac = np.broadcast_to(np.asarray(active_fraction, dtype=float), (m,))
+        offsets = {f: interface_offset(f) for f in np.unique(frac)}
+        d = np.array([offsets[f] for f in frac])
+        active = np.repeat(np.cos(mid_phi)[None, :], m, axis=0).reshape(-1) > d[segment]
+    return quads, face_normals, active, segment
+
+
+def quad_corners(rings: FloatArray) -> FloatArray:
+    """Facet corners ``(E·k, 4, 3)`` from end rings ``(E, 2, k+1, 3)`` (last = first point)."""
+    m, k = rings.shape[0], rings.shape[2] - 1
+    return np.stack(
+        [rings[:, 0, :-1], rings[:, 0, 1:], rings[:, 1, 1:], rings[:, 1, :-1]], axis=2
+    ).reshape(m * k, 4, 3)
+
+
+def _view_vectors(elev: float, azim: float) -> tuple[FloatArray, FloatArray]:
+    """Unit vector toward the camera and toward the light (up and to the left of it)."""
+    el, az = np.radians(elev), np.radians(azim)
+    eye = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    el2, az2 = np.radians(min(elev + 35.0, 85.0)), np.radians(azim + 35.0)
+    light = np.array([np.cos(el2) * np.cos(az2), np.cos(el2) * np.sin(az2), np.sin(el2)])
+    return eye, light
+
+
+def shade(base: FloatArray, normals: FloatArray, eye: FloatArray, light: FloatArray) -> FloatArray:
+    """Lambert (two-sided, with ambient) and Phong-highlight shading of RGB colours ``(F, 3)``."""
+    lam = np.abs(normals @ light)
+    half = _unit(light + eye)
+    spec = np.abs(normals @ half) ** 40
+    rgb = base * (0.38 + 0.62 * lam[:, None]) + 0.35 * spec[:, None]
+    return np.clip(rgb, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class TubePanel:
+    """One panel of :func:`plot_tube_panels`.
+
+    Attributes
+    ----------
+    positions
+        Node positions ``(N, 3)`` (mm).
+    edges
+        Segments ``(E, 2)``.
+    radius
+        Tube radius (mm), scalar or ``(E,)``.
+    normals
+        Interface normal toward the active half per segment ``(E, 3)``, or ``None``.
+    title
+        Panel title (short; one or two lines).
+    ghost
+        Printed node positions ``(N, 3)`` (mm) drawn faintly behind, or ``None``.
+    values
+        Per-segment scalar ``(E,)`` to colour by instead of the Janus sides, or ``None``.
+    active_fraction
+        Active area fraction, scalar or ``(E,)``.
+    """
+
+    positions: FloatArray
+    edges: IntArray
+    radius: float | FloatArray
+    normals: FloatArray | None = None
+    title: str = ""
+    ghost: FloatArray | None = None
+    values: FloatArray | None = None
+    active_fraction: float | FloatArray = 0.5
+
+
+def tube_extent(panels: Sequence[TubePanel]) -> tuple[list[FloatArray], float]:
+    """Box centre of every panel (mm) and one half-width for all (mm): the largest extent of
+    any panel, ghost and tube radius included, so every panel has the same scale."""
+    centres, half = [], 0.0
+    for p in panels:
+        pts = np.asarray(p.positions, dtype=float)
+        allp = pts if p.ghost is None else np.vstack([pts, np.asarray(p.ghost, dtype=float)])
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        centre = 0.5 * (lo + hi)
+        centres.append(centre)
+        # the bounding sphere: its projection fits the panel from any camera angle
+        reach = float(np.linalg.norm(allp - centre, axis=1).max())
+        half = max(half, reach + float(np.max(p.radius)))
+    return centres, (half or 1.0)
+
+
+def _nice_length(span: float) -> float:
+    """A round scale-bar length near a fifth of ``span`` (mm)."""
+    target = max(span / 5.0, 1e-6)
+    power = 10.0 ** np.floor(np.log10(target))
+    for step in (1.0, 2.0, 5.0, 10.0):
+        if step * power >= target:
+            return float(step * power)
+    return float(10.0 * power)
+
+
+def plot_tube_panels(
+    panels: Sequence[TubePanel],
+    *,
+    columns: int | None = None,
+    panel_size: float = 3.6,
+    elev: float = 28.0,
+    azim: float = -58.0,
+    cmap: str | Colormap = "coolwarm",
+    norm: Normalize | None = None,
+    label: str = "",
+    suptitle: str = "",
+    legend: bool = True,
+    facets: int = 16,
+    dpi: float = 100.0,
+    extent: tuple[Sequence[FloatArray], float] | None = None,
+    suptitle_colour: str = "k",
+) -> Figure:
+    """Draw states as shaded Janus tubes, one 3-D panel each, on one common scale.
+
+    Parameters
+    ----------
+    panels
+        The states to draw (at least one).
+    columns
+        Panels per row (default: all in one row up to 4).
+    panel_size
+        Size of a panel (inches).
+    elev, azim
+        Camera angles (degrees), the same in every panel.
+    cmap, norm, label
+        Colour map, limits and colour-bar label for panels with ``values``; ``norm`` is
+        required when any panel has values (so that every panel shares it).
+    suptitle
+        Figure title.
+    legend
+        Draw the legend (active, passive, printed shape) below the panels.
+    facets
+        Facets around each segment; reduced automatically for very large networks.
+    dpi
+        Resolution (dots per inch) of the figure.
+    extent
+        ``(centres, half)``: each panel's box centre (mm) and the common half-width (mm), to
+        keep the scale fixed over an animation; default from the panels (:func:`tube_extent`).
+    suptitle_colour
+        Colour of ``suptitle`` (e.g. red for a state that is not physical).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if not panels:
+        raise InvalidParameterError("panels", "needs at least one panel")
+    if any(p.values is not None for p in panels) and norm is None:
+        raise InvalidParameterError("norm", "give one colour norm shared by every panel")
+    n = len(panels)
+    ncol = min(n, 4) if columns is None else max(1, min(int(columns), n))
+    nrow = -(-n // ncol)
+    total_segments = sum(len(np.asarray(p.edges).reshape(-1, 2)) for p in panels)
+    k = int(max(6, min(facets, MAX_FACETS // max(total_segments, 1))))
+    k -= k % 2
+    has_values = any(p.values is not None for p in panels)
+    extra_w = 0.9 if has_values else 0.0
+    legend_h = 0.5 if legend else 0.0
+    title_h = 0.45 if suptitle else 0.0
+    fig = new_figure(ncol * panel_size + extra_w, nrow * panel_size + legend_h + title_h, dpi=dpi)
+    centres, half = tube_extent(panels) if extent is None else extent
+    eye, light = _view_vectors(elev, azim)
+    colormap = None
+    if has_values:
+        import matplotlib
+
+        colormap = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
+    bottom = legend_h / fig.get_figheight()
+    top = 1.0 - title_h / fig.get_figheight()
+    right = 1.0 - extra_w / fig.get_figwidth()
+    gs = fig.add_gridspec(
+        nrow, ncol, left=0.0, right=right, bottom=bottom, top=top, wspace=0.0, hspace=0.08
+    )
+    bar = _nice_length(2.0 * half)
+    for i, p in enumerate(panels):
+        ax = fig.add_subplot(gs[i // ncol, i % ncol], projection="3d")
+        ax.computed_zorder = False
+        c = centres[i]
+        pos = np.asarray(p.positions, dtype=float)
+        edges = np.asarray(p.edges, dtype=np.int64).reshape(-1, 2)
+        if p.ghost is not None:
+            g = np.asarray(p.ghost, dtype=float)
+            ghost = Line3DCollection(
+                g[edges], colors="0.55", linewidths=1.0, alpha=0.55, linestyles="--", zorder=1
+            )
+            ax.add_collection3d(ghost)
+        quads, fn, active, seg = tube_mesh(
+            pos, edges, p.radius, p.normals, facets=k, active_fraction=p.active_fraction
+        )
+        if p.values is not None and colormap is not None and norm is not None:
+            vals = np.asarray(p.values, dtype=float)[seg]
+            base = np.asarray(colormap(norm(np.ma.masked_invalid(vals))))[:, :3]
+            base[~np.isfinite(vals)] = to_rgb(UNKNOWN_COLOUR)
+        elif active is None:
+            base = np.tile(to_rgb(UNKNOWN_COLOUR), (len(quads), 1))
+        else:
+            base = np.where(active[:, None], to_rgb(ACTIVE_COLOUR), to_rgb(PASSIVE_COLOUR))
+        rgb = shade(base, fn, eye, light)
+        # edges in the face colour hide the hairline seams anti-aliasing leaves between facets
+        poly = Poly3DCollection(quads, facecolors=rgb, edgecolors=rgb, linewidths=0.2, zorder=2)
+        ax.add_collection3d(poly)
+        ax.set_xlim(c[0] - half, c[0] + half)
+        ax.set_ylim(c[1] - half, c[1] + half)
+        ax.set_zlim(c[2] - half, c[2] + half)
+        ax.set_box_aspect((1.0, 1.0, 1.0), zoom=1.55)
+        ax.view_init(elev=elev, azim=azim)
+        ax.set_axis_off()
+        # scale bar along x at the bottom front of the box
+        x0 = c[0] - half * 0.75
+        y0, z0 = c[1] - half * 0.75, c[2] - half * 0.75
+        ax.plot([x0, x0 + bar], [y0, y0], [z0, z0], color="k", lw=2.0, zorder=3)
+        ax.text(
+            x0 + bar / 2,
+            y0,
+            z0 - 0.08 * half,
+            f"{bar:g} mm",
+            ha="center",
+            va="top",
+            fontsize=8,
+            zorder=3,
+        )
+        if p.title:  # inside the panel: never over the figure title or a neighbour
+            ax.text2D(0.5, 0.99, p.title, transform=ax.transAxes, ha="center", va="top", fontsize=9)
+    if has_values and norm is not None and colormap is not None:
+        from matplotlib.cm import ScalarMappable
+
+        cax = fig.add_axes(
+            (
+                right + 0.15 * extra_w / fig.get_figwidth(),
+                bottom + 0.15,
+                0.18 * extra_w / fig.get_figwidth(),
+                (top - bottom) * 0.7,
+            )
+        )
+        fig.colorbar(ScalarMappable(norm=norm, cmap=colormap), cax=cax, label=label)
+    if legend:
+        handles: list[Any] = []
+        if any(p.values is None and p.normals is not None for p in panels):
+            handles += [
+                Patch(color=ACTIVE_COLOUR, label="active half (LCE)"),
+                Patch(color=PASSIVE_COLOUR, label="passive half"),
+            ]
+        if any(p.values is None and p.normals is None for p in panels):
+            handles.append(Patch(color=UNKNOWN_COLOUR, label="sides not stored"))
+        if any(p.ghost is not None for p in panels):
+            from matplotlib.lines import Line2D
+
+            handles.append(Line2D([], [], color="0.55", ls="--", label="printed shape"))
+        if handles:
+            fig.legend(
+                handles=handles,
+                loc="lower center",
+                ncol=len(handles),
+                frameon=False,
+                fontsize=9,
+                bbox_to_anchor=(0.5, 0.0),
+            )
+    if suptitle:
+        fig.suptitle(
+            suptitle,
+            fontsize=11,
+            color=suptitle_colour,
+            y=1.0 - 0.1 * title_h / fig.get_figheight(),
+        )
+    return fig
