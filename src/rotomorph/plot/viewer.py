@@ -22,7 +22,7 @@ from rotomorph.io.results import RunResults
 from rotomorph.io.validity import assess, run_verdict
 from rotomorph.plot.tubes import ACTIVE_COLOUR, PASSIVE_COLOUR, tube_mesh
 
-__all__ = ["viewer_fields", "write_viewer"]
+__all__ = ["viewer_fields", "viewer_figure", "write_viewer"]
 
 #: Radius (mm) of tubes when the run stores none.
 DEFAULT_RADIUS = 0.3
@@ -102,6 +102,14 @@ def write_viewer(
     InvalidParameterError
         An unknown field, or plotly missing.
     """
+    fig = viewer_figure(results, field=field, facets=facets)
+    html = fig.to_html(include_plotlyjs=include_plotlyjs, full_html=True, auto_play=False)
+    return atomic_write_text(path, html)
+
+
+def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8) -> Any:
+    """The plotly figure of :func:`write_viewer`: trace 0 the tubes (``Mesh3d``, one colour
+    value per triangle), trace 1 the printed shape, one frame per step."""
     go = _plotly()
     names = viewer_fields(results)
     if field not in names:
@@ -277,5 +285,4 @@ def write_viewer(
             "margin": {"l": 0, "r": 0, "t": 60, "b": 0},
         },
     )
-    html = fig.to_html(include_plotlyjs=include_plotlyjs, full_html=True, auto_play=False)
-    return atomic_write_text(path, html)
+    return fig

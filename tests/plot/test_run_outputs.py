@@ -1,0 +1,181 @@
+"""A run re-rendered from its files alone: figures, movie, VTK, viewer, verdict in titles.
+
+The run is synthetic (no solver): two filaments of a known shape with their Janus normals,
+written with :func:`write_results` and read back, so these tests are fast.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+
+import meshio
+import numpy as np
+import pytest
+from PIL import Image
+
+from rotomorph.cli import EXIT_OK, EXIT_USAGE, main
+from rotomorph.io.results import read_results, write_results
+from rotomorph.simulate.outputs import plot_run, run_line, write_vtk
+
+
+def _filament(n, steps, y, coil):
+    """(S, n, 3) positions from straight to a coil of ``coil`` turns, and (S, n-1, 3) normals
+    toward the coil axis (the active side on the inside)."""
+    s = np.linspace(0.0, 10.0, n)
+    pos, nor = [], []
+    for k in range(steps):
+        w = k / (steps - 1)
+        if w == 0 or coil == 0:
+            p = np.c_[s, np.full(n, y), np.zeros(n)]
+            nn = np.tile([0.0, 0.0, 1.0], (n - 1, 1))
+        else:
+            r = 10.0 / (2 * np.pi * coil * w)
+            t = s / r
+            p = np.c_[r * np.sin(t), y + 0.2 * s * w, r * (1 - np.cos(t))]
+            mid = 0.5 * (p[1:] + p[:-1])
+            nn = np.c_[-mid[:, 0], np.zeros(n - 1), r - mid[:, 2]]
+            nn /= np.linalg.norm(nn, axis=1)[:, None]
+        pos.append(p)
+        nor.append(nn)
+    return np.stack(pos), np.stack(nor)
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    steps, n = 3, 25
+    p1, n1 = _filament(n, steps, 0.0, 1.0)
+    p2, n2 = _filament(n, steps, 5.0, 0.0)
+    pos = np.concatenate([p1, p2], axis=1)
+    normals = np.concatenate([n1, n2], axis=1)
+    edges = np.array(
+        [[i, i + 1] for i in range(n - 1)] + [[n + i, n + i + 1] for i in range(n - 1)]
+    )
+    ratio = np.stack([np.linalg.norm(p[:, -1] - p[:, 0], axis=1) / 10.0 for p in (p1, p2)], 1)
+    meta = {
+        "kind": "filaments",
+        "design_name": "synthetic",
+        "chains": [
+            {"name": "coil", "start": 0, "stop": n},
+            {"name": "straight", "start": n, "stop": 2 * n},
+        ],
+        "filaments": [
+            {"name": "coil", "end_to_end_ratio": float(ratio[-1, 0]), "morphology": None},
+            {"name": "straight", "end_to_end_ratio": 1.0, "morphology": "straight"},
+        ],
+    }
+    path = tmp_path_factory.mktemp("run") / "results.h5"
+    write_results(
+        path,
+        design={"name": "synthetic"},
+        edges=edges,
+        branch=None,
+        positions=pos,
+        scalars={
+            "temperature": np.array([25.0, 100.0, 175.0]),
+            "converged": np.ones(steps),
+            "stable": np.array([1.0, np.nan, np.nan]),  # the solver did not check
+            "min_clearance": np.array([2.0, 2.0, 0.5]),  # ... and the coil overlaps at the end
+        },
+        fields={
+            "active_normal": normals,
+            "end_to_end_ratio_per_filament": ratio,
+            "curvature": np.zeros((steps, 2 * n)),
+        },
+        units={"end_to_end_ratio_per_filament": "1"},
+        metadata=meta,
+        static={
+            "radius": np.full(len(edges), 0.3),
+            "arc_length": np.tile(np.linspace(0, 10, n), 2),
+        },
+    )
+    return path
+
+
+def test_figures_and_movie_from_the_file_alone(run_file, tmp_path):
+    res = read_results(run_file)
+    paths = plot_run(res, tmp_path / "a" / "figures")  # nested folders are created
+    names = sorted(p.name for p in paths)
+    assert {"shapes.png", "ramp.png", "end_to_end_ratio.png"} <= set(names)
+    with Image.open(tmp_path / "a" / "figures" / "shapes.png") as im:
+        assert im.size[0] >= 1000
+    movie = next(p for p in paths if p.stem == "morphing")
+    if movie.suffix == ".mp4" and shutil.which("ffprobe"):
+        info = subprocess.run(
+            ["ffprobe", "-v", "error", "-show_entries", "stream=width,height",
+             "-show_entries", "format=duration", "-of", "json", str(movie)],
+            capture_output=True, text=True, check=True,
+        )  # fmt: skip
+        data = json.loads(info.stdout)
+        assert float(data["format"]["duration"]) >= 5.0
+        assert data["streams"][0]["width"] >= 1000
+    # the run's verdict: an overlap at the end is named, stability reads as unknown, not fine
+    line = run_line(res)
+    assert "NOT PHYSICAL" in line and "overlap" in line
+    assert "final" not in line
+
+
+def test_titles_never_call_an_unphysical_state_final(run_file, monkeypatch):
+    import rotomorph.simulate.outputs as out
+
+    titles = []
+    real = out._state_title
+
+    def spy(results, k, verdicts):
+        t = real(results, k, verdicts)
+        titles.append(t)
+        return t
+
+    monkeypatch.setattr(out, "_state_title", spy)
+    out._shapes_figure(read_results(run_file), out._verdicts(read_results(run_file)))
+    text, colour = titles[-1]
+    assert "NOT PHYSICAL" in text and "final" not in text.lower() and colour != "k"
+
+
+def test_vtk_files_open_in_meshio_with_units_in_names(run_file, tmp_path):
+    res = read_results(run_file)
+    pvd_vtp, pvd_vtu = write_vtk(res, tmp_path / "paraview")
+    assert pvd_vtp.name == "morphing.pvd" and pvd_vtu.name == "segments.pvd"
+    mesh = meshio.read(tmp_path / "paraview" / "segments_0002.vtu")
+    np.testing.assert_allclose(mesh.points, res.positions[2])
+    lines = mesh.cells_dict["line"]
+    np.testing.assert_array_equal(lines, res.edges)
+    np.testing.assert_allclose(mesh.cell_data["active_normal"][0], res.fields["active_normal"][2])
+    np.testing.assert_allclose(mesh.cell_data["radius [mm]"][0], 0.3)
+    assert "curvature [1/mm]" in mesh.point_data and "arc_length [mm]" in mesh.point_data
+
+
+def test_cli_plot_and_view(run_file, tmp_path, capsys):
+    run = run_file.parent
+    figs = run / "figures"
+    assert main(["plot", str(run_file), "-o", str(figs), "--no-movie"]) == EXIT_OK
+    assert main(["plot", str(run), "-o", str(figs), "--no-movie"]) == EXIT_OK  # again, same place
+    assert not (figs / "figures").exists()
+    pytest.importorskip("plotly")
+    assert main(["view", str(run), "--no-open"]) == EXIT_OK
+    html = (run / "view.html").read_text()
+    assert "plotly" in html.lower() and len(html) > 1_000_000  # plotly.js embedded
+    assert main(["view", str(run), "--field", "nope", "--no-open"]) == EXIT_USAGE
+    assert "nope" in capsys.readouterr().err
+
+
+def test_viewer_figure_has_a_frame_per_step_and_both_sides(run_file):
+    pytest.importorskip("plotly")
+    from rotomorph.plot.viewer import viewer_fields, viewer_figure
+
+    res = read_results(run_file)
+    assert viewer_fields(res)[0] == "janus" and "curvature" in viewer_fields(res)
+    fig = viewer_figure(res, facets=6)
+    assert len(fig.frames) == res.n_steps
+    mesh = fig.frames[-1].data[0]
+    inten = np.asarray(mesh.intensity)
+    assert set(np.unique(inten)) == {0.0, 1.0}  # active and passive halves both shown
+    tri = np.c_[np.asarray(mesh.i), np.asarray(mesh.j), np.asarray(mesh.k)]
+    verts = np.c_[np.asarray(mesh.x), np.asarray(mesh.y), np.asarray(mesh.z)]
+    assert tri.max() < len(verts) and len(inten) == len(tri)
+    area = np.linalg.norm(
+        np.cross(verts[tri[:, 1]] - verts[tri[:, 0]], verts[tri[:, 2]] - verts[tri[:, 0]]), axis=1
+    )
+    assert area.min() > 1e-6  # no degenerate triangles
+    assert "NOT PHYSICAL" in fig.frames[-1].layout.title.text
