@@ -12,7 +12,13 @@ With Dask: ``run_sweep(sweep, "out", executor=client)`` or ``scheduler="tcp://HO
 """
 
 from rotomorph.sweep.run import RunOutcome, RunSpec, execute_run, resolve_run
-from rotomorph.sweep.runner import SweepProgress, SweepResult, plan_sweep, run_sweep
+from rotomorph.sweep.runner import (
+    SweepProgress,
+    SweepResult,
+    local_executor,
+    plan_sweep,
+    run_sweep,
+)
 from rotomorph.sweep.sampling import sample_points
 from rotomorph.sweep.spec import Sweep, load_sweep, parse_sweep, sweep_schema
 from rotomorph.sweep.table import read_table
@@ -25,6 +31,7 @@ __all__ = [
     "SweepResult",
     "execute_run",
     "load_sweep",
+    "local_executor",
     "parse_sweep",
     "plan_sweep",
     "read_table",

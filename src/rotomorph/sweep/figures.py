@@ -63,6 +63,7 @@ def plot_curve(
     outputs: Sequence[str],
     *,
     measured: Sequence[tuple[Any, str]] = (),
+    group: str | None = None,
     title: str = "",
 ) -> Any:
     """Outputs against one parameter, with spread where points share a value.
@@ -77,41 +78,43 @@ def plot_curve(
         Numeric output columns, one panel each.
     measured
         ``(MeasuredTable, output)`` pairs drawn as points with error bars on the panel of
-        ``output`` (e.g. the paper's measurements).
+        ``output`` (e.g. the paper's measurements); or ``(MeasuredTable, "output@value")`` to
+        draw them in the colour of that ``group`` value.
+    group
+        A second parameter column: one curve per value of it (instead of pooling its values
+        into the spread).
     title
         Figure title.
     """
     ok = _ok(table)
     x_all = np.array(_column(table, parameter), dtype=float)
+    g_all = _column(table, group) if group is not None else [None] * len(x_all)
+    levels = list(dict.fromkeys(g_all))
     fig = new_figure(4.6 * len(outputs), 3.8)
     axes = np.atleast_1d(fig.subplots(1, len(outputs)))
     for ax, out in zip(axes, outputs, strict=True):
         y_all = np.array([np.nan if v is None else v for v in _column(table, out)], dtype=float)
-        keep = ok & np.isfinite(y_all) & np.isfinite(x_all)
-        x, y = x_all[keep], y_all[keep]
-        xs = np.unique(x)
-        groups = [y[x == v] for v in xs]
-        mean = np.array([g.mean() for g in groups])
-        if any(len(g) > 1 for g in groups):
-            lo = np.array([g.min() for g in groups])
-            hi = np.array([g.max() for g in groups])
-            sd = np.array([g.std() for g in groups])
-            ax.fill_between(xs, lo, hi, color="C0", alpha=0.2, label="min–max")
-            ax.errorbar(xs, mean, yerr=sd, fmt="o-", ms=3, color="C0", capsize=2, label="mean ± sd")
-        else:
-            ax.plot(xs, mean, "o-", ms=3, color="C0", label="rotomorph")
-        for data, target in measured:
-            if target == out:
-                ax.errorbar(
-                    data.x,
-                    data.value,
-                    yerr=data.spread,
-                    fmt="s",
-                    color="k",
-                    ms=5,
-                    capsize=3,
-                    label=f"measured ({data.name})",
-                )
+        for k, level in enumerate(levels):
+            colour = f"C{k}"
+            keep = ok & np.isfinite(y_all) & np.isfinite(x_all)
+            keep &= np.array([g == level for g in g_all])
+            label = "rotomorph" if group is None else f"{group} = {level}"
+            _draw_curve(ax, x_all[keep], y_all[keep], colour, label)
+            for data, target in measured:
+                name, _, at = target.partition("@")
+                if name == out and (not at or (group is not None and at == str(level))):
+                    ax.errorbar(
+                        data.x,
+                        data.value,
+                        yerr=data.spread,
+                        fmt="s",
+                        mfc="white",
+                        mec=colour if at else "k",
+                        ecolor=colour if at else "k",
+                        ms=6,
+                        capsize=3,
+                        label=f"measured ({data.name})",
+                    )
         n_bad = int((~ok).sum())
         if n_bad:
             ax.text(
@@ -120,10 +123,26 @@ def plot_curve(
         ax.set_xlabel(parameter + _unit(table, parameter))
         ax.set_ylabel(out + _unit(table, out))
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=7)
     if title:
         fig.suptitle(title)
     return fig
+
+
+def _draw_curve(ax: Any, x: np.ndarray, y: np.ndarray, colour: str, label: str) -> None:
+    xs = np.unique(x)
+    groups = [y[x == v] for v in xs]
+    mean = np.array([g.mean() for g in groups])
+    if any(len(g) > 1 for g in groups):
+        lo = np.array([g.min() for g in groups])
+        hi = np.array([g.max() for g in groups])
+        sd = np.array([g.std() for g in groups])
+        ax.fill_between(xs, lo, hi, color=colour, alpha=0.2, label=f"{label}: min–max")
+        ax.errorbar(
+            xs, mean, yerr=sd, fmt="o-", ms=3, color=colour, capsize=2, label=f"{label}: mean ± sd"
+        )
+    else:
+        ax.plot(xs, mean, "o-", ms=3, color=colour, label=label)
 
 
 def plot_phase_diagram(
@@ -135,7 +154,7 @@ def plot_phase_diagram(
     labels = _column(table, output)
     physical = _column(table, "physical")
     ok = _ok(table)
-    fig = new_figure(6.4, 4.8)
+    fig = new_figure(8.0, 4.8)
     ax = fig.add_subplot()
     for name, colour in MORPHOLOGY_COLOURS.items():
         sel = ok & np.array([lab == name for lab in labels])
@@ -159,7 +178,7 @@ def plot_phase_diagram(
     ax.set_xlabel(x + _unit(table, x))
     ax.set_ylabel(y + _unit(table, y))
     ax.set_title(title or f"{output} over ({x}, {y})")
-    ax.legend(fontsize=8, loc="best", framealpha=0.85)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.grid(alpha=0.2)
     return fig
 

@@ -70,6 +70,13 @@ METRICS: tuple[Metric, ...] = (
         "closed_form_end_to_end_ratio", "1", "float", "filament", "L/L0 of the closed-form helix"
     ),
     Metric("closed_form_morphology", "", "str", "filament", "label of the closed-form helix"),
+    Metric(
+        "closed_form_curvature",
+        "1/mm",
+        "float",
+        "filament",
+        "curvature of the closed-form helix (per current length)",
+    ),
     Metric("min_clearance", "1", "float", "filament", "closest non-adjacent segments (diameters)"),
     Metric("stable", "", "bool", "filament", "stability reported by the solver (null if not)"),
     Metric("energy", "N mm", "float", "filament", "elastic energy at the last step"),
@@ -219,6 +226,7 @@ def filament_metrics(sim: Any, radius: float) -> dict[str, Any]:
         if closed is None
         else _number(closed.end_to_end_ratio),
         "closed_form_morphology": None if closed is None else str(closed.label),
+        "closed_form_curvature": None if closed is None else _number(closed.curvature),
         "min_clearance": _number(_clearance(sim.printed, sim.positions[-1], radius)),
         "stable": None if stable is None else bool(stable),
         "energy": _number(sim.energy[-1]),

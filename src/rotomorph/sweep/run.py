@@ -20,13 +20,16 @@ kept in the diagnostics).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import logging
 import os
 import socket
+import threading
 import time
 import traceback
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -197,32 +200,64 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
     return metrics, sim.run_results() if spec.hdf5 else None
 
 
+class _Collect(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.thread = threading.get_ident()
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.thread == self.thread:
+            msg = record.getMessage()
+            if msg not in self.messages and len(self.messages) < 20:
+                self.messages.append(msg)
+
+
+@contextlib.contextmanager
+def _captured_warnings() -> Iterator[list[str]]:
+    """Collect the library's warnings of this run (kept in its record, not printed)."""
+    logger = logging.getLogger("rotomorph")
+    handler = _Collect()
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield handler.messages
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+
+
 def execute_run(spec: RunSpec) -> RunOutcome:
     """Compute one run; errors are returned in the record, never raised.
 
     The record holds ``run_id``, ``status`` (:data:`STATUSES`), ``metrics`` (all metrics of the
     run's kind, :mod:`rotomorph.sweep.metrics`), ``error`` (``None`` or type, message,
-    diagnostics), ``wall_time_s``, ``version``, ``host`` and ``pid``.
+    diagnostics), ``warnings`` (the library's logged warnings during the run, at most 20
+    distinct; not printed), ``wall_time_s``, ``version``, ``host`` and ``pid``.
     """
     t0 = time.perf_counter()
     metrics: dict[str, Any] = {}
     results = None
     error = spec.error
+    warnings: list[str] = []
     if error is not None:
         status = "invalid"
     else:
-        try:
-            metrics, results = _compute(spec)
-            status = "ok"
-        except (InvalidParameterError, MachineLimitError) as err:
-            status, error = "invalid", error_record(err)
-        except Exception as err:  # a failed run must not stop the sweep
-            status, error = "failed", error_record(err)
+        with _captured_warnings() as warnings:
+            try:
+                metrics, results = _compute(spec)
+                status = "ok"
+            except (InvalidParameterError, MachineLimitError) as err:
+                status, error = "invalid", error_record(err)
+            except Exception as err:  # a failed run must not stop the sweep
+                status, error = "failed", error_record(err)
     record = {
         "run_id": spec.run_id,
         "status": status,
         "metrics": to_jsonable(metrics),
         "error": None if error is None else dict(error),
+        "warnings": list(warnings),
         "wall_time_s": time.perf_counter() - t0,
         "version": rotomorph.__version__,
         "host": socket.gethostname(),

@@ -39,7 +39,7 @@ from rotomorph.sweep.spec import Sweep
 from rotomorph.sweep.store import RunStore
 from rotomorph.sweep.table import TABLE_FILE, build_table, write_table
 
-__all__ = ["SweepProgress", "SweepResult", "plan_sweep", "run_sweep"]
+__all__ = ["SweepProgress", "SweepResult", "local_executor", "plan_sweep", "run_sweep"]
 
 logger = logging.getLogger(__name__)
 
@@ -138,14 +138,23 @@ def _executor(executor: Any, scheduler: str | None, workers: int | None) -> Iter
         with client:
             yield client.get_executor()
         return
+    with local_executor(workers) as ex:
+        yield ex
+
+
+def local_executor(workers: int | None = None) -> cf.ProcessPoolExecutor:
+    """The default local pool: ``workers`` processes (default: CPU count), warmed up.
+
+    Use it as a context manager to share one pool between several sweeps
+    (``run_sweep(..., executor=pool)``).
+    """
     if workers is not None and workers < 1:
         raise InvalidParameterError("workers", f"must be >= 1; got {workers}")
-    with cf.ProcessPoolExecutor(
+    return cf.ProcessPoolExecutor(
         max_workers=workers or os.cpu_count() or 1,
         mp_context=_pool_context(),
         initializer=_warm_worker,
-    ) as ex:
-        yield ex
+    )
 
 
 def _pool_context() -> Any:

@@ -21,6 +21,8 @@ one column per output
     of the same sweep).
 ``error_type``, ``error_message`` (string), ``error_diagnostics`` (string, JSON)
     Null for ``ok`` runs.
+``warnings`` (string, JSON list)
+    Warnings the library logged during the run (null if none).
 
 Each field's metadata carries its ``unit``; the schema's metadata carries the sweep's name and
 sha256, and the rotomorph version.
@@ -38,12 +40,30 @@ from rotomorph.io.atomic import atomic_path
 from rotomorph.sweep.metrics import METRICS, is_physical, select_output
 from rotomorph.sweep.spec import Sweep
 
-__all__ = ["TABLE_FILE", "build_table", "read_table", "write_table"]
+__all__ = ["PARAMETER_UNITS", "TABLE_FILE", "build_table", "read_table", "write_table"]
 
 #: File name of the table in a sweep folder.
 TABLE_FILE = "results.parquet"
 
 _ARROW = {"float": "float64", "int": "int64", "str": "string", "bool": "bool_"}
+
+#: Unit of a parameter column by the design field it sets (the last key of its path).
+PARAMETER_UNITS = {
+    "speed": "mm/s",
+    "rotation": "rad/s",
+    "rotation_number": "1",
+    "active_fraction": "1",
+    "length": "mm",
+    "radius": "mm",
+    "spacing": "mm",
+    "amplitude": "mm",
+    "wavelength": "mm",
+    "layer_height": "mm",
+    "flip_length": "mm",
+    "angle_deg": "deg",
+    "heading_deg": "deg",
+    "interface_angle_deg": "deg",
+}
 
 
 def _param_type(values: Sequence[Any]) -> Any:
@@ -106,7 +126,8 @@ def build_table(
     add("run_id", [rec["run_id"] for _, _, rec in rows], pa.string())
     for param in sweep.parameters:
         values = [p[param.path] for _, p, _ in rows]
-        add(param.column, values, _param_type(values))
+        unit = PARAMETER_UNITS.get(param.path.rsplit(".", 1)[-1], "")
+        add(param.column, values, _param_type(values), unit)
     for out in sweep.outputs:
         metric = _output_metric(out, scope)
         values = [select_output(rec["metrics"], out) for _, _, rec in rows]
@@ -126,6 +147,11 @@ def build_table(
     add(
         "error_diagnostics",
         [json.dumps(e["diagnostics"], sort_keys=True) if e else None for e in errors],
+        pa.string(),
+    )
+    add(
+        "warnings",
+        [json.dumps(rec["warnings"]) if rec.get("warnings") else None for _, _, rec in rows],
         pa.string(),
     )
     meta = {
