@@ -102,7 +102,8 @@ def plot_curve(
             _draw_curve(ax, x_all[keep], y_all[keep], colour, label)
             for data, target in measured:
                 name, _, at = target.partition("@")
-                if name == out and (not at or (group is not None and at == str(level))):
+                drawn_once = not at and k == 0
+                if name == out and (drawn_once or (group is not None and at == str(level))):
                     ax.errorbar(
                         data.x,
                         data.value,
