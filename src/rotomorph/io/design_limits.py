@@ -55,19 +55,19 @@ class Limit:
 
 #: Ranges by quantity; the schema attaches one to every numeric field (docs/design-files.md).
 LIMITS: Final = {
-    "extent": Limit(0.0, 10_000.0, "mm", exclusive_min=True),  # lengths, radii, wavelengths
+    "extent": Limit(0.001, 10_000.0, "mm"),  # lengths, radii, wavelengths
     "coordinate": Limit(-10_000.0, 10_000.0, "mm"),  # start, origin, polyline points
     "speed": Limit(0.01, 500.0, "mm/s"),  # F0.0100 at 4 decimals: never a zero feed
     "rotation": Limit(-1_000.0, 1_000.0, "rad/s"),
     "rotation_number": Limit(-100.0, 100.0, ""),
     "angle_deg": Limit(-360.0, 360.0, "deg"),
     "arc_angle_deg": Limit(-36_000.0, 36_000.0, "deg"),
-    "filament_radius": Limit(0.0, 10.0, "mm", exclusive_min=True),
+    "filament_radius": Limit(0.01, 10.0, "mm"),
     "vertex_spacing": Limit(0.001, 100.0, "mm"),
     "periods": Limit(0.0, 10_000.0, "", exclusive_min=True),
     "pressure": Limit(0.0, 1_000.0, "psi"),
-    "nozzle_diameter": Limit(0.0, 10.0, "mm", exclusive_min=True),
-    "layer_height": Limit(0.0, 10.0, "mm", exclusive_min=True),
+    "nozzle_diameter": Limit(0.01, 10.0, "mm"),
+    "layer_height": Limit(0.001, 10.0, "mm"),
     "lattice_n": Limit(2, 10_000, ""),
     "ghost_nodes": Limit(1, 1_000, ""),
     "layers": Limit(1, 1_000, ""),

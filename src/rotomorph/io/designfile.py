@@ -242,6 +242,22 @@ class Filament(_Control):
         return _check_material(name, "passive")
 
     @model_validator(mode="after")
+    def _rotation_rate(self) -> Filament:
+        """ω = ω*·v/R must stay within the rotation range too (a tiny R makes ω* absurd)."""
+        top = LIMITS["rotation"].maximum
+        for i, seg in enumerate(self.segments):
+            number = seg.rotation_number
+            if number is None and seg.rotation is None and seg.interface_angle_deg is None:
+                number = self.rotation_number
+            rate = abs(number or 0.0) * (seg.speed or self.speed) / self.radius
+            if rate > top:
+                raise ValueError(
+                    f"segments[{i}]: rotation_number gives ω = ω*·v/R = {rate:.4g} rad/s, above "
+                    f"{top:g} rad/s; lower rotation_number or speed, or increase radius"
+                )
+        return self
+
+    @model_validator(mode="after")
     def _size(self) -> Filament:
         nodes = self.node_count()
         if nodes < 3:
