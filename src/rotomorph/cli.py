@@ -24,10 +24,7 @@ import argparse
 import contextlib
 import json
 import logging
-import os
-import shutil
 import sys
-import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -89,10 +86,13 @@ def _load_design(path: str) -> Any:
 
 @contextlib.contextmanager
 def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
-    """Yield a temporary folder next to ``path``; rename it onto ``path`` on success.
+    """Yield a temporary folder next to ``path``; swap it onto ``path`` on success.
 
-    On error the temporary folder is removed and ``path`` is untouched.
+    On error (or SIGTERM) the temporary folder is removed and ``path`` is untouched
+    (:func:`rotomorph.io.atomic.atomic_folder`).
     """
+    from rotomorph.io.atomic import atomic_folder
+
     if not path:
         raise UsageError("-o/--output: empty path; give a folder name")
     target = Path(path)
@@ -104,26 +104,8 @@ def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
     if parent.exists() and not parent.is_dir():
         raise UsageError(f"-o/--output: {parent}: exists and is not a folder")
     parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=parent))
-    try:
+    with atomic_folder(target) as tmp:
         yield tmp
-        os.chmod(tmp, 0o777 & ~_umask())
-        if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=parent))
-            os.replace(target, old / "x")
-            os.replace(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, target)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
 
 
 def _print(text: str) -> None:
@@ -429,8 +411,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Terminated(BaseException):
+    """SIGTERM (``timeout``, batch schedulers), raised so that temporaries are cleaned up."""
+
+
+@contextlib.contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """While running a command, SIGTERM unwinds like Ctrl-C (exit status 143)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise _Terminated()
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``rotomorph`` with ``argv`` (default ``sys.argv[1:]``) and return the exit code."""
+    with _sigterm_raises():
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(None if argv is None else list(argv))
@@ -459,6 +470,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail(f"{name}{err.strerror or err}", EXIT_USAGE)
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
+    except _Terminated:
+        return _fail("terminated (SIGTERM); no partial output left behind", 143)
 
 
 def _fail(message: str, code: int) -> int:

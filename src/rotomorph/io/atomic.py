@@ -10,17 +10,47 @@ file) in place. Use :func:`atomic_write_bytes` / :func:`atomic_write_text` for d
 
 The temporary file keeps the target's suffix (``.png``, ``.gif`` …) so that libraries that
 infer the format from the name still work. The parent folder must exist.
+
+Folders (a run's results) are written with :func:`atomic_folder`: into a temporary sibling
+folder, then swapped onto the target in one atomic step (Linux ``renameat2`` with
+``RENAME_EXCHANGE``), so a reader sees the old results or the new ones, never neither.
+
+Temporaries are named ``.<name>.tmp-<host>-<pid>-<random>`` (and ``.<name>.old-…`` for the
+previous results during a replacement where no atomic exchange exists). A process killed
+outright (SIGKILL, power loss) cannot clean up; the next atomic write in the same folder
+finds temporaries whose process is gone (:func:`remove_stale`) and removes them — restoring
+previous results that a replacement had moved aside if the target is missing. The CLI turns
+SIGTERM into a clean exit, so ``timeout`` and batch schedulers leave nothing behind.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import ctypes.util
+import logging
 import os
+import re
+import shutil
+import socket
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text"]
+__all__ = [
+    "atomic_folder",
+    "atomic_path",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "remove_stale",
+    "temporary_prefix",
+]
+
+logger = logging.getLogger(__name__)
+_HOST = re.sub(r"[^A-Za-z0-9]", "", socket.gethostname())[:32] or "host"
+_STALE = re.compile(
+    r"^\.(?P<name>.+)\.(?P<kind>tmp|old)-(?P<host>[A-Za-z0-9]+)-(?P<pid>\d+)-[A-Za-z0-9_]+"
+)
 
 
 def _current_umask() -> int:
@@ -52,6 +82,135 @@ def _remove_quietly(path: Path) -> None:
         os.unlink(path)
 
 
+def temporary_prefix(target: Path, kind: str = "tmp") -> str:
+    """Prefix of the temporaries of ``target``: ``.<name>.<kind>-<host>-<pid>-``."""
+    return f".{target.name}.{kind}-{_HOST}-{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True  # someone else's process (or not a pid we can test): leave it
+    return True
+
+
+def remove_stale(folder: str | os.PathLike[str]) -> list[Path]:
+    """Remove temporaries in ``folder`` left by processes of this host that no longer run.
+
+    A stale ``.<name>.old-…`` (previous results moved aside by a replacement that was killed
+    half way) is renamed back onto ``<name>`` if that is missing, else removed. Temporaries
+    of live processes, of other hosts and any other file are left alone.
+
+    Returns
+    -------
+    list of pathlib.Path
+        What was removed or restored (logged at INFO).
+    """
+    done = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return done
+    for entry in entries:
+        m = _STALE.match(entry.name)
+        if m is None or m["host"] != _HOST or _alive(int(m["pid"])):
+            continue
+        path = Path(entry.path)
+        target = path.parent / m["name"]
+        try:
+            if m["kind"] == "old" and not target.exists() and not target.is_symlink():
+                os.rename(path, target)
+                logger.info("restored %s from an interrupted replacement", target)
+            elif entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(path)
+                logger.info("removed stale temporary folder %s", path)
+            else:
+                os.unlink(path)
+                logger.info("removed stale temporary file %s", path)
+        except FileNotFoundError:
+            continue  # another process cleaned it first
+        done.append(path)
+    return done
+
+
+_CLEANED: set[str] = set()
+
+
+def _remove_stale_once(folder: Path) -> None:
+    """:func:`remove_stale` once per folder and process (a sweep writes thousands of files)."""
+    key = os.path.realpath(folder)
+    if key not in _CLEANED:
+        _CLEANED.add(key)
+        remove_stale(folder)
+
+
+_RENAME_EXCHANGE = 2
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux ``renameat2(RENAME_EXCHANGE)``); False if unsupported."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd = -100
+    rc = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), _RENAME_EXCHANGE)
+    if rc == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (22, 38, 95):  # EINVAL, ENOSYS, EOPNOTSUPP: file system or kernel cannot
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield an empty temporary folder next to ``path``; put it onto ``path`` on success.
+
+    Parameters
+    ----------
+    path
+        The folder to (re)place. Its parent must exist; an existing folder of that name is
+        replaced (the caller decides whether that is allowed).
+
+    Notes
+    -----
+    An existing target is swapped with the new folder in one atomic step where the system
+    allows it (Linux ``renameat2``), else moved aside to ``.<name>.old-…`` just before the new
+    folder is renamed into place (a window of two renames, repaired by :func:`remove_stale`
+    if the process dies inside it). On an exception (also a SIGTERM turned into one) the
+    temporary folder is removed and ``path`` is untouched. Stale temporaries of dead
+    processes in the parent folder are removed first.
+    """
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    remove_stale(parent)
+    tmp = Path(tempfile.mkdtemp(prefix=temporary_prefix(target), dir=parent))
+    try:
+        yield tmp
+        os.chmod(tmp, 0o777 & ~_UMASK)
+        if target.is_dir() and not target.is_symlink():
+            if not _exchange(tmp, target):
+                old = Path(tempfile.mkdtemp(prefix=temporary_prefix(target, "old"), dir=parent))
+                os.rmdir(old)
+                os.rename(target, old)
+                os.rename(tmp, target)
+                tmp = old
+            shutil.rmtree(tmp, ignore_errors=True)  # now the previous results
+        else:
+            os.replace(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    _fsync_dir(parent)
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str], *, fsync: bool = True) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; move it onto ``path`` when the block succeeds.
@@ -66,8 +225,9 @@ def atomic_path(path: str | os.PathLike[str], *, fsync: bool = True) -> Iterator
     Yields
     ------
     pathlib.Path
-        An empty, already created temporary file ``.<name>.tmp-<random><suffix>`` in the same
-        folder; the caller (or the library it calls) overwrites it.
+        An empty, already created temporary file ``.<name>.tmp-<host>-<pid>-<random><suffix>``
+        in the same folder; the caller (or the library it calls) overwrites it. Stale
+        temporaries of dead processes in that folder are removed first (:func:`remove_stale`).
 
     Notes
     -----
@@ -78,7 +238,8 @@ def atomic_path(path: str | os.PathLike[str], *, fsync: bool = True) -> Iterator
     """
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
-    fd, name = tempfile.mkstemp(dir=folder, prefix=f".{target.name}.tmp-", suffix=target.suffix)
+    _remove_stale_once(folder)
+    fd, name = tempfile.mkstemp(dir=folder, prefix=temporary_prefix(target), suffix=target.suffix)
     os.close(fd)
     tmp = Path(name)
     try:
