@@ -111,7 +111,7 @@ def remove_stale(folder: str | os.PathLike[str]) -> list[Path]:
     list of pathlib.Path
         What was removed or restored (logged at INFO).
     """
-    done = []
+    done: list[Path] = []
     try:
         entries = list(os.scandir(folder))
     except OSError:
