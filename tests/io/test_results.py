@@ -172,3 +172,68 @@ def test_to_jsonable_converts_numpy():
     out = to_jsonable({"a": np.float32(1.5), "b": np.arange(3), "c": (np.True_, np.inf)})
     assert out == {"a": 1.5, "b": [0, 1, 2], "c": [True, None]}
     assert json.dumps(out)
+
+
+def test_static_arrays_and_print_programs_round_trip(tmp_path, run):
+    from rotomorph.design.program import PrintProgram
+    from rotomorph.io.results import program_record
+
+    net, positions, scalars, _, design = run
+    pts = np.c_[np.linspace(0, 5, 6), np.zeros(6), np.zeros(6)]
+    prog = PrintProgram(points=pts, speed=np.full(6, 3.0), nozzle_angle=np.linspace(0, 1, 6))
+    static = {
+        "arc_length": np.linspace(0, 5, 6),
+        "radius": np.full(5, 0.3),
+        "filament_id": np.zeros(6, dtype=int),
+    }
+    path = write_results(
+        tmp_path / "r.h5",
+        design=design,
+        edges=net.edges,
+        branch=net.branch,
+        positions=positions,
+        scalars=scalars,
+        fields={"active_normal": np.tile([0.0, 0.0, 1.0], (4, 5, 1))},
+        static=static,
+        programs=[program_record(prog, "w*=0.25")],
+        metadata={"physical": {"verdict": "no", "reason": "filaments overlap"}},
+    )
+    res = read_results(path)
+    np.testing.assert_array_equal(res.static["arc_length"], static["arc_length"])
+    assert res.units["arc_length"] == "mm" and res.units["radius"] == "mm"
+    assert res.units["active_normal"] == "1" and res.static["filament_id"].dtype.kind == "i"
+    (p,) = res.programs
+    np.testing.assert_array_equal(p["points"], pts)
+    assert p["name"] == "w*=0.25" and p["radius"] == 0.3 and p["active_material"] == "lce"
+    with h5py.File(path, "r") as h5:
+        assert h5.attrs["physical"] == "no" and h5.attrs["physical_reason"] == "filaments overlap"
+        assert h5["programs/0000/speed"].attrs["units"] == "mm/s"
+        assert h5["programs/0000"].attrs["radius_units"] == "mm"
+    with pytest.raises(InvalidParameterError) as info:
+        write_results(
+            tmp_path / "bad.h5",
+            design=design,
+            edges=net.edges,
+            branch=net.branch,
+            positions=positions,
+            scalars=scalars,
+            static={"radius": np.zeros(3)},
+        )
+    assert info.value.field == "static['radius']"
+
+
+def test_version_1_files_still_read(tmp_path, run):
+    net, positions, scalars, _, design = run
+    path = write_results(
+        tmp_path / "old.h5",
+        design=design,
+        edges=net.edges,
+        branch=net.branch,
+        positions=positions,
+        scalars=scalars,
+    )
+    with h5py.File(path, "a") as h5:  # what version 1 wrote: no static, no programs
+        del h5["static"], h5["programs"]
+        h5.attrs["format_version"] = 1
+    res = read_results(path)
+    assert res.static == {} and res.programs == () and res.n_steps == 4

@@ -165,3 +165,42 @@ def test_pvd_relative_paths(tmp_path):
     assert 'file="frames/f0.vtp"' in pvd.read_text()
     with pytest.raises(InvalidParameterError, match="finite"):
         write_pvd(tmp_path / "b.pvd", [(np.nan, "x.vtp")])
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_vtu_line_cells_read_by_meshio(tmp_path, binary):
+    from rotomorph.io.vtk import write_vtu, write_vtu_series
+
+    rng = np.random.default_rng(1)
+    points = rng.normal(size=(6, 3))
+    segments = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0]])
+    normals = rng.normal(size=(6, 3))
+    path = write_vtu(
+        tmp_path / "s.vtu",
+        points,
+        segments,
+        point_data={"twist [1/mm]": np.r_[np.nan, rng.normal(size=5)]},
+        cell_data={"active_normal": normals, "lattice_edge": np.arange(6)},
+        binary=binary,
+    )
+    mesh = meshio.read(path)
+    np.testing.assert_allclose(mesh.points, points)
+    np.testing.assert_array_equal(mesh.cells_dict["line"], segments)
+    np.testing.assert_allclose(mesh.cell_data["active_normal"][0], normals)
+    np.testing.assert_array_equal(mesh.cell_data["lattice_edge"][0].ravel(), np.arange(6))
+    assert np.isnan(mesh.point_data["twist [1/mm]"][0])
+    frames = np.stack([points, points + 1.0])
+    pvd = write_vtu_series(
+        tmp_path / "seg.pvd",
+        frames,
+        segments,
+        times=[25.0, 175.0],
+        cell_data={"radius [mm]": np.full((2, 6), 0.3)},
+    )
+    assert pvd.read_text().count("<DataSet") == 2
+    np.testing.assert_allclose(meshio.read(tmp_path / "seg_0001.vtu").points, points + 1.0)
+    with pytest.raises(InvalidParameterError, match="segments"):
+        write_vtu(tmp_path / "bad.vtu", points, [[0, 6]])
+    with pytest.raises(InvalidParameterError, match="cell_data"):
+        write_vtu(tmp_path / "bad.vtu", points, segments, cell_data={"x": np.zeros(5)})
+    assert not (tmp_path / "bad.vtu").exists()

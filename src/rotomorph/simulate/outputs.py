@@ -210,6 +210,13 @@ def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     )
 
 
+def _filament_step_verdict(results: RunResults, i: int, k: int, verdicts: list[StepVerdict]) -> str:
+    """Verdict of filament ``i`` at step ``k``: its own where the run stored one, else the run's."""
+    info = results.metadata.get("filaments", [])
+    steps = ((info[i].get("physical") or {}).get("steps") if i < len(info) else None) or []
+    return str(steps[k]) if k < len(steps) else verdicts[k].verdict
+
+
 def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     """Filaments (up to 4) across the ramp: 4 states each, one common scale."""
     from rotomorph.plot.tubes import plot_tube_panels
@@ -221,7 +228,7 @@ def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     for i in rows:
         for k in steps:
             p = _filament_panels(results, k, rows=[i])[0]
-            mark = {"no": " NOT PHYSICAL", "unknown": "", "yes": ""}[verdicts[k].verdict]
+            mark = {"no": " NOT PHYSICAL"}.get(_filament_step_verdict(results, i, k, verdicts), "")
             first = p.title.split("\n")[0]
             label = f"{first}\n{_labels(results)[k]}{mark}"
             panels.append(type(p)(**{**p.__dict__, "title": label}))

@@ -31,7 +31,13 @@ from rotomorph.geometry import polyline_strains
 from rotomorph.io.results import RunResults, program_record, to_jsonable
 from rotomorph.io.validity import assess, verdict_record
 
-__all__ = ["active_normals", "chain_segments", "describe_run", "material_twist"]
+__all__ = [
+    "active_normals",
+    "chain_clearance",
+    "chain_segments",
+    "describe_run",
+    "material_twist",
+]
 
 
 def chain_segments(edges: IntArray, chain: IntArray) -> IntArray:
@@ -84,11 +90,31 @@ def material_twist(
     return out
 
 
-def _clearance(positions: FloatArray, edges: IntArray, diameter: float) -> FloatArray:
-    from rotomorph.lattice.heating import fused_pairs, segment_clearance
+def chain_clearance(positions: FloatArray, diameter: float) -> FloatArray:
+    """Smallest distance between the segments of one filament per step, in diameters ``(S,)``.
 
-    fused = fused_pairs(positions[0], edges, diameter)
-    return np.array([segment_clearance(p, edges, diameter, ignore=fused) for p in positions])
+    Pairs closer along the filament than π·d (printed arc length) are skipped: a tube of
+    diameter d cannot bend back onto itself over a shorter length, so their distance says
+    nothing about overlap (a filament that contracts brings them closer without any overlap).
+    Above 2 diameters the value is capped at 2.
+    """
+    from rotomorph.lattice.heating import segment_clearance
+
+    p0 = np.asarray(positions[0], dtype=float)
+    n = len(p0)
+    if n < 3:
+        return np.full(len(positions), 2.0)
+    edges = np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)
+    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p0, axis=0), axis=1))]
+    mid = 0.5 * (arc[:-1] + arc[1:])
+    stop = np.searchsorted(mid, mid + np.pi * diameter, side="left")  # first j too far
+    count = stop - np.arange(n - 1) - 1
+    i = np.repeat(np.arange(n - 1), count)
+    j = i + 1 + (np.arange(len(i)) - np.repeat(np.cumsum(count) - count, count))
+    skip = np.stack([i, j], axis=1)
+    return np.array(
+        [segment_clearance(p, edges, diameter, ignore=skip) for p in np.asarray(positions)]
+    )
 
 
 def _combine(flags: FloatArray) -> FloatArray:
@@ -141,8 +167,7 @@ def _filament_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, 
         if fil.states:
             m1, nn = active_normals(fil.states, program.interface_normals)
             directors[:, segs], normals[:, segs] = m1, nn
-        local = np.stack([np.arange(len(nodes) - 1), np.arange(1, len(nodes))], axis=1)
-        clearance[i] = _clearance(fil.positions, local, 2.0 * program.radius)
+        clearance[i] = chain_clearance(fil.positions, 2.0 * program.radius)
     scalars = {"stable": _combine(stable), "min_clearance": _combine(clearance)}
     fields = {"directors": directors, "active_normal": normals}
     per_filament = [
