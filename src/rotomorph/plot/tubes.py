@@ -16,6 +16,7 @@ panels. Colours are either the Janus sides or a per-segment field with a colour 
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -253,20 +254,23 @@ class TubePanel:
     active_fraction: float | FloatArray = 0.5
 
 
-def tube_extent(panels: Sequence[TubePanel]) -> tuple[list[FloatArray], float]:
-    """Box centre of every panel (mm) and one half-width for all (mm): the largest extent of
-    any panel, ghost and tube radius included, so every panel has the same scale."""
-    centres, half = [], 0.0
+def tube_extent(panels: Sequence[TubePanel]) -> tuple[list[FloatArray], FloatArray]:
+    """Box centre of every panel and one box for all: half-widths ``(3,)`` along x, y, z (mm).
+
+    Each half-width is the largest half-extent along that axis over the panels (ghost and
+    tube radius included), at least 15 % of the largest one so flat shapes keep some depth;
+    the boxes are drawn with the aspect of these half-widths, so every panel and every axis
+    has the same millimetres per pixel.
+    """
+    centres, half = [], np.zeros(3)
     for p in panels:
         pts = np.asarray(p.positions, dtype=float)
         allp = pts if p.ghost is None else np.vstack([pts, np.asarray(p.ghost, dtype=float)])
         lo, hi = allp.min(axis=0), allp.max(axis=0)
-        centre = 0.5 * (lo + hi)
-        centres.append(centre)
-        # the bounding sphere: its projection fits the panel from any camera angle
-        reach = float(np.linalg.norm(allp - centre, axis=1).max())
-        half = max(half, reach + float(np.max(p.radius)))
-    return centres, (half or 1.0)
+        centres.append(0.5 * (lo + hi))
+        half = np.maximum(half, 0.5 * (hi - lo) + 1.5 * float(np.max(p.radius)))
+    biggest = float(half.max()) or 1.0
+    return centres, np.maximum(half, 0.15 * biggest)
 
 
 def _nice_length(span: float) -> float:
@@ -320,7 +324,7 @@ def plot_tube_panels(
     dpi
         Resolution (dots per inch) of the figure.
     extent
-        ``(centres, half)``: each panel's box centre (mm) and the common half-width (mm), to
+        ``(centres, half)``: each panel's box centre (mm) and the common half-widths (mm), to
         keep the scale fixed over an animation; default from the panels (:func:`tube_extent`).
     suptitle_colour
         Colour of ``suptitle`` (e.g. red for a state that is not physical).
@@ -342,9 +346,16 @@ def plot_tube_panels(
     has_values = any(p.values is not None for p in panels)
     extra_w = 0.9 if has_values else 0.0
     legend_h = 0.5 if legend else 0.0
-    title_h = 0.45 if suptitle else 0.0
-    fig = new_figure(ncol * panel_size + extra_w, nrow * panel_size + legend_h + title_h, dpi=dpi)
+    width = ncol * panel_size + extra_w
+    # wrap the title to the figure (11 pt characters are about 0.55 em wide)
+    title_lines = (
+        textwrap.wrap(suptitle, max(20, int(width * 72 / (11 * 0.55)))) if suptitle else []
+    )
+    suptitle = "\n".join(title_lines)
+    title_h = 0.25 + 0.22 * len(title_lines) if title_lines else 0.0
     centres, half = tube_extent(panels) if extent is None else extent
+    half = np.broadcast_to(np.asarray(half, dtype=float), (3,))
+    fig = new_figure(width, nrow * panel_size + legend_h + title_h, dpi=dpi)
     eye, light = _view_vectors(elev, azim)
     colormap = None
     if has_values:
@@ -357,7 +368,7 @@ def plot_tube_panels(
     gs = fig.add_gridspec(
         nrow, ncol, left=0.0, right=right, bottom=bottom, top=top, wspace=0.0, hspace=0.08
     )
-    bar = _nice_length(2.0 * half)
+    bar = _nice_length(2.0 * float(half.max()))
     for i, p in enumerate(panels):
         ax = fig.add_subplot(gs[i // ncol, i % ncol], projection="3d")
         ax.computed_zorder = False
@@ -385,20 +396,20 @@ def plot_tube_panels(
         # edges in the face colour hide the hairline seams anti-aliasing leaves between facets
         poly = Poly3DCollection(quads, facecolors=rgb, edgecolors=rgb, linewidths=0.2, zorder=2)
         ax.add_collection3d(poly)
-        ax.set_xlim(c[0] - half, c[0] + half)
-        ax.set_ylim(c[1] - half, c[1] + half)
-        ax.set_zlim(c[2] - half, c[2] + half)
-        ax.set_box_aspect((1.0, 1.0, 1.0), zoom=1.55)
+        ax.set_xlim(c[0] - half[0], c[0] + half[0])
+        ax.set_ylim(c[1] - half[1], c[1] + half[1])
+        ax.set_zlim(c[2] - half[2], c[2] + half[2])
+        ax.set_box_aspect(tuple(half), zoom=1.0)
         ax.view_init(elev=elev, azim=azim)
         ax.set_axis_off()
         # scale bar along x at the bottom front of the box
-        x0 = c[0] - half * 0.75
-        y0, z0 = c[1] - half * 0.75, c[2] - half * 0.75
+        x0 = c[0] - half[0] * 0.95
+        y0, z0 = c[1] - half[1], c[2] - half[2]
         ax.plot([x0, x0 + bar], [y0, y0], [z0, z0], color="k", lw=2.0, zorder=3)
         ax.text(
             x0 + bar / 2,
             y0,
-            z0 - 0.08 * half,
+            z0 - 0.06 * float(half.max()),
             f"{bar:g} mm",
             ha="center",
             va="top",
@@ -443,9 +454,6 @@ def plot_tube_panels(
             )
     if suptitle:
         fig.suptitle(
-            suptitle,
-            fontsize=11,
-            color=suptitle_colour,
-            y=1.0 - 0.1 * title_h / fig.get_figheight(),
+            suptitle, fontsize=11, color=suptitle_colour, y=1.0 - 0.08 / fig.get_figheight()
         )
     return fig

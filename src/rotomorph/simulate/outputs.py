@@ -342,9 +342,8 @@ def _movie(results: RunResults, verdicts: list[StepVerdict], path: Path) -> Path
     n_panels = len(per_step[0][0])
     lo = [np.min([s[0][i] for s in per_step], axis=0) for i in range(n_panels)]
     hi = [np.max([s[0][i] for s in per_step], axis=0) for i in range(n_panels)]
-    half = max(s[1] for s in per_step) + 0.5 * max(
-        float(np.max(h - l)) for l, h in zip(lo, hi, strict=True)
-    )
+    moves = np.max([h - l for l, h in zip(lo, hi, strict=True)], axis=0)
+    half = np.max([s[1] for s in per_step], axis=0) + 0.5 * moves
     extent = ([0.5 * (l + h) for l, h in zip(lo, hi, strict=True)], half)
     ncol = min(n_panels, 4)
     size = max(4.0, 12.8 / ncol) if n_panels > 1 else 7.2
@@ -358,7 +357,7 @@ def _movie(results: RunResults, verdicts: list[StepVerdict], path: Path) -> Path
             columns=ncol,
             suptitle_colour=colour,
             panel_size=size,
-            facets=10,
+            facets=12,
             dpi=max(100.0, 1280.0 / (ncol * size)),
         )
         return figure_to_rgb(fig)
