@@ -19,7 +19,7 @@ printed (fused at junctions). Contact is not modelled: values < 1 mean filaments
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -56,7 +56,9 @@ __all__ = [
 #: shape measures resolve, and it lets Newton stop near a bifurcation from the flat state, where
 #: the Hessian is nearly singular and convergence turns linear (a step at the saddle's onset
 #: took > 200 iterations at the solver's default 1e-9).
-RAMP_OPTIONS = NewtonOptions(rtol=1e-7, max_iterations=300)
+#: Every step is certified stable; the lowest Hessian eigenvalue is kept (one is enough to
+#: see a bifurcation coming and costs one shift-invert Lanczos run).
+RAMP_OPTIONS = NewtonOptions(rtol=1e-7, max_iterations=300, eigenvalues=1)
 
 SupportsName = Literal["free", "clamped-boundary", "pinned-centre"]
 
@@ -192,6 +194,10 @@ class HeatingResult:
         the Janus sides.
     stable
         Per step: the solver's stability verdict, ``None`` where it gave none.
+    lowest_eigenvalue
+        Lowest Hessian eigenvalue of each equilibrium (N/mm², see
+        :mod:`rotomorph.solve.stability`; NaN for row 0 and when not computed): it drops
+        toward 0 where the lattice approaches a bifurcation.
     """
 
     parameter: FloatArray
@@ -212,6 +218,7 @@ class HeatingResult:
     actuation: str
     states: tuple[State, ...] = ()
     stable: tuple[bool | None, ...] = ()
+    lowest_eigenvalue: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def final_area_ratio(self) -> float:
@@ -410,6 +417,7 @@ def heat_lattice(
         actuation=act.name,
         states=(lm.model.reference_state(), *(r.state for r in path.results)),
         stable=(True, *(_stable_flag(r) for r in path.results)),
+        lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues],
     )
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -98,6 +98,8 @@ class FilamentSimulation:
         not (step 0, the stress-free printed state, is ``True``).
     program
         The print program simulated.
+    lowest_eigenvalue
+        ``(S,)`` lowest Hessian eigenvalue of each equilibrium (N/mm²; NaN for step 0).
     """
 
     name: str
@@ -117,6 +119,7 @@ class FilamentSimulation:
     states: tuple[State, ...] = ()
     stable: tuple[bool | None, ...] = ()
     program: Any = None
+    lowest_eigenvalue: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def final_ratio(self) -> float:
@@ -328,6 +331,7 @@ def simulate_filament(
         states=states,
         stable=stable,
         program=program,
+        lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues],
     )
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import ConvergenceError, InvalidParameterError
 
 __all__ = ["ContinuationResult", "ContinuationStep", "continuation"]
@@ -70,6 +70,21 @@ class ContinuationResult:
     def final(self) -> Any:
         """Result at the last parameter value."""
         return self.steps[-1].result
+
+    @property
+    def stable(self) -> BoolArray:
+        """Per step: the equilibrium was certified stable (False where the solver's result
+        carries no ``stable`` verdict)."""
+        return np.array([bool(getattr(s.result, "stable", False)) for s in self.steps])
+
+    @property
+    def lowest_eigenvalues(self) -> FloatArray:
+        """Per step: the lowest Hessian eigenvalue the solver reported (NaN where none)."""
+        out = []
+        for s in self.steps:
+            ev = getattr(s.result, "eigenvalues", None)
+            out.append(float(ev[0]) if ev is not None and len(ev) else np.nan)
+        return np.array(out, dtype=float)
 
 
 def _default_state(result: Any) -> Any:

@@ -9,8 +9,15 @@ the classical one (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 3.2
 1. factor ``H + tau M``, raising ``tau`` until positive definite (so the step is a descent
    direction and saddle points repel), lowering it again after good steps;
 2. backtracking Armijo line search on the energy (the merit function);
-3. stop when the weighted gradient norm is below ``rtol`` times the force scale, or when a pure
-   Newton step's decrement is below ``decrement_tol`` times the energy scale.
+3. stop when the weighted gradient norm is below ``rtol`` times the force scale (a pure Newton
+   step whose decrement is below ``decrement_tol`` times the energy scale is taken whole, without
+   a line search, but the residual test still decides);
+4. certify the exit point (:mod:`rotomorph.solve.spectrum`): the Hessian on the free DOFs with
+   rigid modes removed must be positive definite. At a saddle (e.g. a straight column above its
+   Euler load, where the gradient vanishes by symmetry) the solver steps along the direction of
+   negative curvature with a second-order Armijo test (Moré & Sorensen, *Math. Programming* 16,
+   1979) and continues; the same happens when the iteration stalls (no decrease) on an
+   indefinite Hessian. An equilibrium that stays unstable ends with ``Status.SADDLE``.
 """
 
 from __future__ import annotations
@@ -25,6 +32,7 @@ from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.solve.linalg import diagonal, factorize, matvec
 from rotomorph.solve.result import NewtonResult, Status
+from rotomorph.solve.spectrum import Spectrum, analyse_hessian
 
 log = logging.getLogger(__name__)
 
@@ -107,6 +115,18 @@ class NewtonOptions:
         Relative shift above which the Hessian counts as indefinite for that search.
     endgame
         Residual below which free bodies get the rigid-rotation shift floor (see the loop).
+    check_stability
+        Certify every exit point a minimum and leave saddles (see the module docstring).
+    eigenvalues
+        Lowest Hessian eigenvalues to report at the exit point (0: the verdict only).
+    keep_modes
+        Keep the eigenvectors of those eigenvalues in the result.
+    stability_tol
+        Eigenvalues above ``-stability_tol`` times the Hessian's diagonal scale count as
+        neutral (stable).
+    saddle_escapes
+        Steps along negative curvature allowed before an unstable exit is reported as
+        ``Status.SADDLE``.
     """
 
     max_iterations: int = 200
@@ -117,6 +137,11 @@ class NewtonOptions:
     curvature_iterations: int = 6
     endgame: float = 1e-3
     curvature_shift: float = 1e-9
+    check_stability: bool = True
+    eigenvalues: int = 3
+    keep_modes: bool = False
+    stability_tol: float = 1e-12
+    saddle_escapes: int = 10
 
     def __post_init__(self) -> None:
         if self.max_iterations < 1:
@@ -125,6 +150,16 @@ class NewtonOptions:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise InvalidParameterError(f"NewtonOptions.{name}", f"must be > 0; got {v}")
+        for name in ("eigenvalues", "saddle_escapes"):
+            v = getattr(self, name)
+            if int(v) != v or v < 0:
+                raise InvalidParameterError(
+                    f"NewtonOptions.{name}", f"must be an integer >= 0; got {v}"
+                )
+        if not (np.isfinite(self.stability_tol) and self.stability_tol >= 0):
+            raise InvalidParameterError(
+                "NewtonOptions.stability_tol", f"must be >= 0; got {self.stability_tol}"
+            )
 
 
 def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = None) -> NewtonResult:
@@ -153,14 +188,50 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     dec = np.inf
     status = Status.MAX_ITERATIONS
     it = 0
+    exact = True  # H is the exact Hessian at x (not the convex approximation)
+    spec: Spectrum | None = None
+    escapes = 0
+    stall = False  # a null step on an indefinite Hessian: check for a saddle at the top
+    stall_checked = False  # ... once until the next escape
+    floor_steps = 0  # whole Newton steps that did not lower the residual
     while it < opt.max_iterations:
         res = float(_norm(w * g)) / fscale
         if not np.isfinite(f) or not np.isfinite(res):
             status = Status.NOT_FINITE
             break
-        if res <= opt.rtol:
+        if res <= opt.rtol and not opt.check_stability:
             status = Status.CONVERGED
             break
+        if res <= opt.rtol or stall:
+            # 4) certify the exit point; leave a saddle along its negative curvature
+            stall = False
+            if not exact:
+                f, g, H = obj.evaluate(x, True, 1)
+                exact = True
+            spec = _certify(obj, H, opt)
+            n_fact += spec.factorizations
+            if spec.stable:
+                if res <= opt.rtol:
+                    status = Status.CONVERGED
+                    break
+                stall_checked = True
+            else:
+                mode = spec.negative_mode()
+                moved = None
+                if mode is not None and escapes < opt.saddle_escapes:
+                    moved = _leave_saddle(obj, x, f, g, mode, spec.lowest, opt.armijo)
+                if moved is None:
+                    status = Status.SADDLE
+                    break
+                escapes += 1
+                it += 1
+                x = moved
+                obj.accept(x)
+                f, g, H = obj.evaluate(x, True, 1)
+                exact, spec, stall_checked = True, None, False
+                tau, skip_exact, backoff, first_try_ok = 0.0, 0, 0, True
+                history.append((f, float(_norm(w * g)) / fscale, 1.0, 0.0))
+                continue
         it += 1
         # 1) Newton with the exact Hessian (a tiny shift covers free rigid-body modes); after
         #    the exact Hessian was found indefinite, it is retried only after 1, 2, 4, ...
@@ -216,14 +287,24 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         d = obj.project(d)
         slope = _dot(g, d)
         dec = -0.5 * slope / escale
-        if pure and dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
-            x = obj.retract(x, d, min(1.0, obj.max_step(x, d)))
-            obj.accept(x)
-            f, g, H = obj.evaluate(x, True, True)
-            res = float(_norm(w * g)) / fscale
-            history.append((f, res, 1.0, shift))
-            status = Status.CONVERGED
-            return _result(x, status, it, n_fact, f, res, dec, history)
+        if dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
+            if pure:
+                # the energy is flat to round-off: take the whole step without a line search;
+                # only the residual test at the top may accept the point
+                x = obj.retract(x, d, min(1.0, obj.max_step(x, d)))
+                obj.accept(x)
+                f, g, H = obj.evaluate(x, True, 1)
+                exact = True
+                new = float(_norm(w * g)) / fscale
+                history.append((f, new, 1.0, shift))
+                floor_steps = floor_steps + 1 if new >= 0.5 * res else 0
+                if floor_steps >= 3 and new > opt.rtol:
+                    status, res = Status.STALLED, new
+                    break
+                continue
+            if opt.check_stability and not stall_checked:
+                stall = True  # no decrease left on an indefinite Hessian: a saddle?
+                continue
         alpha = min(1.0, obj.max_step(x, d))
         accepted = False
         for _ in range(opt.max_backtracks):
@@ -248,20 +329,61 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                     skip_exact = 1
                     if convex:
                         H = obj.convex_hessian(x)
+                        exact = False
                 history.append((f, res, 0.0, tau))
                 continue
             status = Status.LINE_SEARCH_FAILED
             break
         x = xt
+        floor_steps = 0
         obj.accept(x)
         # exact Hessian (mode 1) unless the backoff asks for the convex one next (mode 2)
-        f, g, H = obj.evaluate(x, True, 1 if (skip_exact == 0 or not convex) else 2)
+        exact = skip_exact == 0 or not convex
+        f, g, H = obj.evaluate(x, True, 1 if exact else 2)
         history.append((f, float(_norm(w * g)) / fscale, alpha, shift))
         log.debug(
             "newton %d: E=%.6e res=%.3e alpha=%.3g shift=%.3g", it, f, history[-1][1], alpha, shift
         )
     res = float(_norm(w * g)) / fscale
-    return _result(x, status, it, n_fact, f, res, dec, history)
+    return _result(x, status, it, n_fact, f, res, dec, history, spec, escapes)
+
+
+def _certify(obj: Objective, H: Any, opt: NewtonOptions) -> Spectrum:
+    """Stability of the current iterate (the objective's base) from its exact Hessian ``H``."""
+    rigid = getattr(obj, "rigid_modes", None)
+    return analyse_hessian(
+        H,
+        obj.metric(),
+        None if rigid is None else rigid(),
+        count=opt.eigenvalues,
+        modes=opt.keep_modes,
+        tol=opt.stability_tol,
+    )
+
+
+def _leave_saddle(obj, x, f, g, v, lam, armijo):  # type: ignore[no-untyped-def]
+    """A point of lower energy along ``+-v`` (unit M-norm, curvature ``lam < 0``), or None.
+
+    The step starts at the objective's physical curvature step (a rod turns its most-turned
+    edge by 0.2 rad) and is halved until the second-order Armijo condition
+    ``f(x + a v) <= f + armijo (a g.v + a^2 lam / 2)`` holds. Both signs are tried; the lower
+    energy wins, ``+v`` on a tie (the sign of ``v`` is normalised, so this is reproducible).
+    """
+    a = obj.curvature_step_scale(x, v)
+    a = a if a > 0 else 1.0
+    gv = _dot(g, v)
+    for _ in range(30):
+        best = None
+        for sgn in (1.0, -1.0):
+            xt = obj.retract(x, sgn * v, a)
+            ft = obj.evaluate(xt, False, False)[0]
+            bound = f + armijo * (sgn * a * gv + 0.5 * a * a * lam)
+            if np.isfinite(ft) and ft <= bound and (best is None or ft < best[1]):
+                best = (xt, ft)
+        if best is not None:
+            return best[0]
+        a *= 0.5
+    return None
 
 
 def _dot(a: FloatArray, b: FloatArray) -> float:
@@ -305,8 +427,13 @@ def _scale_curvature_step(obj, x, v, d, M):  # type: ignore[no-untyped-def]
     return scale * v
 
 
-def _result(x, status, it, n_fact, f, res, dec, history) -> NewtonResult:  # type: ignore[no-untyped-def]
+def _result(x, status, it, n_fact, f, res, dec, history, spec=None, escapes=0) -> NewtonResult:  # type: ignore[no-untyped-def]
+    certified = spec is not None and status is Status.CONVERGED
     return NewtonResult(
+        stable=spec.stable if certified else None,  # type: ignore[union-attr]
+        eigenvalues=spec.eigenvalues if certified else np.zeros(0),  # type: ignore[union-attr]
+        modes=spec.modes if certified else None,  # type: ignore[union-attr]
+        escapes=escapes,
         x=x,
         status=status,
         iterations=it,

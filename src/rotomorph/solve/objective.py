@@ -530,6 +530,38 @@ class RodObjective:
         u[self._theta_index] += alpha * du[self._theta_index]
         return u[self.free]
 
+    def rigid_modes(self) -> FloatArray:
+        """Rigid motions of a free body at the base ``(n_free, 6)``; ``(n_free, 0)`` if supported,
+        ``(n_free, 3)`` (the motions along it) on a floor.
+
+        Three translations and three rotations about the metric-weighted centroid; a rotation
+        ``omega`` moves node ``i`` by ``omega x r_i`` and adds ``omega . t_j`` to the twist
+        angle of edge ``j`` (the material frame turns with the body). These are the exact
+        zero-energy directions the stability test removes.
+        """
+        if not self._free_body:
+            return np.zeros((len(self.free), 0))
+        lay = self.model.layout
+        if self._floor_normal is not None:  # on a floor only the motions along it are free
+            return tangent_rigid_modes(
+                self.base.positions,
+                self.base.tangents,
+                np.asarray(self._floor_normal.normal),
+                lay.pos,
+                lay.theta,
+                lay.count,
+            ).T[self.free]
+        x = self.base.positions
+        m = self._node_metric
+        r = x - m @ x / m.sum()
+        modes = np.zeros((lay.count, 6))
+        for k in range(3):
+            modes[lay.pos + k, k] = 1.0
+            axis = np.eye(3)[k]
+            modes[self._pos_index, 3 + k] = np.cross(axis, r).ravel()
+            modes[lay.theta, 3 + k] = self.base.tangents[:, k]
+        return modes[self.free]
+
 
 _TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 

@@ -17,6 +17,8 @@ class Status(Enum):
     MAX_ITERATIONS = "max_iterations"
     LINE_SEARCH_FAILED = "line_search_failed"
     NOT_FINITE = "not_finite"
+    STALLED = "stalled"  # whole Newton steps no longer lower a residual above rtol (round-off)
+    SADDLE = "saddle"  # an equilibrium with negative curvature that could not be left
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +43,16 @@ class NewtonResult:
         Last Newton decrement ``-g.d`` divided by the energy scale (dimensionless).
     history
         Per-iteration ``(energy, residual, step length, shift)`` rows.
+    stable
+        Whether ``x`` was certified a local minimum on the free DOFs with rigid modes removed
+        (:mod:`rotomorph.solve.spectrum`); None when not checked (not converged, or disabled).
+    eigenvalues
+        Lowest eigenvalues of the Hessian at ``x`` in the solver's metric, ascending (N/mm²
+        for rods); empty when not computed.
+    modes
+        Their eigenvectors ``(n, k)`` when asked for (``NewtonOptions.keep_modes``).
+    escapes
+        Steps taken along a direction of negative curvature from an unstable equilibrium.
     """
 
     x: FloatArray
@@ -51,6 +63,10 @@ class NewtonResult:
     residual: float
     decrement: float
     history: FloatArray = field(default_factory=lambda: np.zeros((0, 4)))
+    stable: bool | None = None
+    eigenvalues: FloatArray = field(default_factory=lambda: np.zeros(0))
+    modes: FloatArray | None = None
+    escapes: int = 0
 
     @property
     def converged(self) -> bool:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.contact.potential import Contact, ContactPotential
@@ -14,6 +16,7 @@ from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.newton import NewtonOptions, minimize
 from rotomorph.solve.objective import RodObjective
 from rotomorph.solve.result import Status
+from rotomorph.solve.stability import Modes, mode_fields
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,6 +42,18 @@ class StaticResult:
         The contact model bound to the network when the solve had contact (None otherwise):
         ``result.contact.forces(result.positions)``, ``.clearance(...)``,
         ``.active_contacts(...)``.
+    stable
+        True: certified a local minimum (the Hessian on the free DOFs, rigid motions removed,
+        is positive definite or neutral within round-off; see
+        :mod:`rotomorph.solve.stability`). False only when ``NewtonOptions.check_stability``
+        was switched off and the point is unchecked.
+    eigenvalues
+        Lowest Hessian eigenvalues at the equilibrium, ascending (N/mm²; how many:
+        ``NewtonOptions.eigenvalues``).
+    modes
+        Their mode shapes when ``NewtonOptions.keep_modes`` is set, else None.
+    escapes
+        Steps the solver took off unstable equilibria (saddles) on the way.
     """
 
     state: State
@@ -49,6 +64,10 @@ class StaticResult:
     residual: float
     wall_time: float
     contact: ContactPotential | None = None
+    stable: bool = False
+    eigenvalues: FloatArray = field(default_factory=lambda: np.zeros(0))
+    modes: Modes | None = None
+    escapes: int = 0
 
     @property
     def positions(self) -> FloatArray:
@@ -65,6 +84,10 @@ def solve_static(
     contact: Contact | None = None,
 ) -> StaticResult:
     """Find a stable equilibrium of ``model`` under ``supports`` and ``loads``.
+
+    The equilibrium returned is certified a local minimum (``result.stable``); from an
+    unstable one (e.g. a perfectly straight column above its Euler load) the solver steps
+    along the direction of negative curvature and goes on (:mod:`rotomorph.solve.newton`).
 
     Parameters
     ----------
@@ -89,7 +112,9 @@ def solve_static(
     InfeasibleContactError
         If the initial state already touches or interpenetrates.
     ConvergenceError
-        If Newton's method does not converge; ``error.result`` holds the diagnostics
+        If Newton's method does not converge, stalls at its round-off floor above ``rtol``
+        (``Status.STALLED``) or ends on an equilibrium it cannot leave although it is unstable
+        (``Status.SADDLE``); ``error.result`` holds the diagnostics
         (:class:`~rotomorph.solve.result.NewtonResult`) and ``error.state`` the last iterate.
     """
     t0 = time.perf_counter()
@@ -98,10 +123,10 @@ def solve_static(
     res = minimize(obj, obj.vector(), options)
     final = obj.base
     if res.status is not Status.CONVERGED:
+        hint = _HINTS.get(res.status, _HINTS[Status.MAX_ITERATIONS])
         err = ConvergenceError(
             f"static solve did not converge: {res.status.value} after {res.iterations} "
-            f"iterations (residual {res.residual:.3e}); try load stepping (continuation), a "
-            "larger NewtonOptions.max_iterations, or check supports and loads",
+            f"iterations (residual {res.residual:.3e}); {hint}",
             result=res,
         )
         err.state = final  # type: ignore[attr-defined]
@@ -115,4 +140,18 @@ def solve_static(
         residual=res.residual,
         wall_time=time.perf_counter() - t0,
         contact=obj.contact,
+        stable=bool(res.stable),
+        eigenvalues=res.eigenvalues,
+        modes=None if res.modes is None else mode_fields(obj, res.modes),
+        escapes=res.escapes,
     )
+
+
+_HINTS = {
+    Status.MAX_ITERATIONS: "try load stepping (continuation), a larger "
+    "NewtonOptions.max_iterations, or check supports and loads",
+    Status.STALLED: "the residual is at its round-off floor (very stiff axial springs "
+    "against small loads); raise NewtonOptions.rtol above the residual shown",
+    Status.SADDLE: "the equilibrium reached is unstable and no energy-lowering step along "
+    "its negative curvature was found; perturb the initial state or step the load",
+}

@@ -1,0 +1,193 @@
+"""Every equilibrium the solver returns is certified a minimum; saddles are left.
+
+Exact references: the clamped–free elastica (elliptic integrals), the Euler load of the same
+column from the tangent stiffness, the free–free beam's bending eigenvalues, Rosenbrock's
+Hessian, a two-variable saddle with known minima.
+"""
+
+from __future__ import annotations
+
+import doctest
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, rosen, rosen_der, rosen_hess
+from scipy.special import ellipe, ellipk
+
+import rotomorph.solve.stability as stability_module
+from rotomorph.errors import ConvergenceError, InvalidParameterError
+from rotomorph.rod.model import Model
+from rotomorph.solve.loads import Loads, Supports
+from rotomorph.solve.newton import FunctionObjective, NewtonOptions, minimize
+from rotomorph.solve.result import Status
+from rotomorph.solve.stability import stability
+from rotomorph.solve.static import solve_static
+
+E, RADIUS, LENGTH = 1.0, 0.3, 10.0  # MPa, mm, mm
+B = E * np.pi * RADIUS**4 / 4  # N mm²
+P_CR = np.pi**2 * B / (4 * LENGTH**2)  # clamped–free Euler load (N)
+RAMP = NewtonOptions(rtol=1e-7, max_iterations=300)  # the lattice ramps' tolerance
+
+
+def column(n: int) -> Model:
+    """A straight isotropic column whose clamped first edge is centred on the origin, so the
+    free length from the clamp (the midpoint of that edge) to the loaded tip is LENGTH."""
+    h = LENGTH / (n - 1.5)
+    s = -h / 2 + h * np.arange(n)
+    return Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=B,
+        bending_stiffness2=B,
+        twist_stiffness=B / 1.3,
+        axial_stiffness=100 * E * np.pi * RADIUS**2,  # nearly inextensible
+    )
+
+
+def elastica_tip(ratio: float) -> tuple[float, float]:
+    """Tip of the clamped–free elastica under ``ratio`` x P_cr: (x, lateral) / L.
+
+    ``sqrt(P/B) L = K(k)``, ``x/L = 2E(k)/K(k) - 1``, ``y/L = 2k/K(k)`` with ``k = sin(a/2)``
+    and ``a`` the tip rotation (Timoshenko & Gere, *Theory of Elastic Stability*, § 2.7).
+    """
+    K = np.sqrt(ratio) * np.pi / 2
+    m = brentq(lambda m: ellipk(m) - K, 1e-12, 1 - 1e-14)
+    return 2 * ellipe(m) / K - 1, 2 * np.sqrt(m) / K
+
+
+@pytest.mark.parametrize("options", [None, RAMP], ids=["default-tol", "ramp-tol"])
+def test_straight_column_above_euler_load_buckles_to_the_elastica(options):
+    n = 41
+    model = column(n)
+    res = solve_static(
+        model, Supports.clamp_ends(n), Loads(forces=[(n - 1, (-3 * P_CR, 0.0, 0.0))]), None, options
+    )
+    assert res.status is Status.CONVERGED and res.stable and res.escapes >= 1
+    x_tip = res.positions[-1, 0] / LENGTH
+    y_tip = np.hypot(*res.positions[-1, 1:]) / LENGTH
+    x_ref, y_ref = elastica_tip(3.0)  # (-0.2041, 0.7074): the tip swings behind the clamp
+    assert y_tip == pytest.approx(y_ref, abs=1.5e-3)
+    assert x_tip == pytest.approx(x_ref, abs=5e-3)  # O(h^2): 2.4e-3 at n = 41
+    assert res.iterations <= 15  # pinned (11-12 with one escape)
+
+
+def test_straight_column_below_euler_load_stays_straight_and_stable():
+    n = 41
+    res = solve_static(
+        column(n), Supports.clamp_ends(n), Loads(forces=[(n - 1, (-0.8 * P_CR, 0.0, 0.0))])
+    )
+    assert res.stable and res.escapes == 0
+    assert np.abs(res.positions[:, 1:]).max() == 0.0
+    assert res.eigenvalues[0] > 0
+
+
+def test_euler_load_from_the_tangent_stiffness():
+    """The lowest eigenvalue of the straight compressed column changes sign at P_cr."""
+    n = 41
+    model, supports = column(n), Supports.clamp_ends(n)
+    lowest = []
+    for f in (0.9, 1.1):
+        loads = Loads(forces=[(n - 1, (-f * P_CR, 0.0, 0.0))])
+        straight = solve_static(
+            model, supports, loads, options=NewtonOptions(check_stability=False)
+        )
+        res = stability(model, straight.state, supports, loads, count=2)
+        assert res.stable == (f < 1) and res.rigid_modes == 0
+        # isotropic section: the two bending planes give a double eigenvalue
+        assert res.eigenvalues[1] == pytest.approx(res.eigenvalues[0], rel=1e-6)
+        lowest.append(res.eigenvalues[0])
+    crossing = 0.9 + 0.2 * lowest[0] / (lowest[0] - lowest[1])
+    assert crossing == pytest.approx(1.0, abs=3e-3)
+
+
+def test_free_free_beam_bending_eigenvalues():
+    """Free–free beam of unit mass per length: lambda = B (beta/L)^4, beta = 4.7300, 7.8532;
+    the six rigid motions are removed; B2 = 2 B1 separates the two bending planes."""
+    n = 81
+    s = np.linspace(0, LENGTH, n)
+    model = Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=B,
+        bending_stiffness2=2 * B,
+        twist_stiffness=B / 1.3,
+        axial_stiffness=100 * E * np.pi * RADIUS**2,
+    )
+    res = stability(model, count=4)
+    assert res.rigid_modes == 6 and res.stable
+    unit = B * (4.730040745 / LENGTH) ** 4
+    expected = np.array(
+        [1.0, 2.0, (7.853204624 / 4.730040745) ** 4, 2 * (7.853204624 / 4.730040745) ** 4]
+    )
+    np.testing.assert_allclose(res.eigenvalues / unit, expected, rtol=4e-3)
+    # the first mode bends toward m1 = +z (B1) and is symmetric about the middle
+    mode = res.modes.displacements[0]
+    assert np.abs(mode[:, 2]).max() > 100 * np.abs(mode[:, 1]).max()
+    np.testing.assert_allclose(mode[:, 2], mode[::-1, 2], atol=1e-8 * np.abs(mode).max())
+
+
+def test_stability_rejects_a_bad_count():
+    with pytest.raises(InvalidParameterError, match="count"):
+        stability(column(5), count=0)
+
+
+def test_stability_docstring_example_runs():
+    failures = doctest.testmod(stability_module, verbose=False).failed
+    assert failures == 0
+
+
+def test_rosenbrock_minimum_is_certified_with_its_eigenvalues():
+    obj = FunctionObjective(rosen, rosen_der, rosen_hess)
+    res = minimize(obj, np.array([-1.2, 1.0]))
+    assert res.converged and res.stable and res.escapes == 0
+    np.testing.assert_allclose(
+        res.eigenvalues, np.linalg.eigvalsh(rosen_hess(np.ones(2))), rtol=1e-6
+    )
+
+
+def _saddle_objective() -> FunctionObjective:
+    """f = x^2 - y^2 + y^4: a saddle at the origin, minima at (0, +-1/sqrt 2)."""
+    return FunctionObjective(
+        lambda v: v[0] ** 2 - v[1] ** 2 + v[1] ** 4,
+        lambda v: np.array([2 * v[0], -2 * v[1] + 4 * v[1] ** 3]),
+        lambda v: np.diag([2.0, -2.0 + 12 * v[1] ** 2]),
+    )
+
+
+def test_a_saddle_reached_exactly_is_left_along_negative_curvature():
+    res = minimize(_saddle_objective(), np.array([0.5, 0.0]))
+    assert res.converged and res.stable and res.escapes == 1
+    np.testing.assert_allclose(np.abs(res.x), [0.0, 1 / np.sqrt(2)], atol=1e-9)
+    # without the check the solver never leaves the saddle's line y = 0
+    plain = minimize(
+        _saddle_objective(), np.array([0.5, 0.0]), NewtonOptions(check_stability=False)
+    )
+    assert plain.stable is None and abs(plain.x[1]) == 0.0
+
+
+def test_an_unleavable_saddle_is_reported_not_converged():
+    res = minimize(_saddle_objective(), np.array([0.5, 0.0]), NewtonOptions(saddle_escapes=0))
+    assert res.status is Status.SADDLE and not res.converged
+
+
+def test_decrement_exit_does_not_accept_a_residual_above_rtol():
+    """Flat energy, constant gradient 1e-8 (a round-off floor): the Newton decrement is tiny,
+    but the residual is 10x rtol; the old exit reported CONVERGED here."""
+    obj = FunctionObjective(lambda v: 0.0, lambda v: np.full(2, 1e-8), lambda v: np.eye(2))
+    res = minimize(obj, np.zeros(2), NewtonOptions(rtol=1e-9))
+    assert res.status is Status.STALLED and not res.converged and res.residual > 1e-9
+    assert minimize(obj, np.zeros(2), NewtonOptions(rtol=1e-7)).converged
+
+
+def test_solve_static_names_a_stalled_residual():
+    # EA / (B / L^2) = 1e8: the residual's round-off floor is above rtol = 1e-10
+    n = 41
+    s = np.linspace(0, LENGTH, n)
+    model = Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=1e-2,
+        bending_stiffness2=1e-2,
+        twist_stiffness=1e-2,
+        axial_stiffness=1e4,
+    )
+    loads = Loads(forces=[(n - 1, (-1e-3, 0.0, 0.0))])
+    with pytest.raises(ConvergenceError, match="round-off floor"):
+        solve_static(model, Supports.clamp_ends(n), loads, options=NewtonOptions(rtol=1e-10))
