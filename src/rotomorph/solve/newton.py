@@ -101,7 +101,9 @@ class NewtonOptions:
     max_iterations
         Newton iterations allowed; reaching it is reported, never called convergence.
     rtol
-        Weighted gradient norm relative to the force scale at which to stop.
+        Weighted gradient norm relative to the force scale at which to stop; never below the
+        round-off floor the objective estimates (``residual_floor()``, e.g. a nearly
+        inextensible rod far from the origin), which the result reports.
     decrement_tol
         Newton decrement ``-g.d / 2`` relative to the energy scale at which to stop.
     armijo
@@ -199,10 +201,11 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         if not np.isfinite(f) or not np.isfinite(res):
             status = Status.NOT_FINITE
             break
-        if res <= opt.rtol and not opt.check_stability:
+        rtol = max(opt.rtol, _residual_floor(obj) / fscale)
+        if res <= rtol and not opt.check_stability:
             status = Status.CONVERGED
             break
-        if res <= opt.rtol or stall:
+        if res <= rtol or stall:
             # 4) certify the exit point; leave a saddle along its negative curvature
             stall = False
             if not exact:
@@ -211,7 +214,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             spec = _certify(obj, H, opt)
             n_fact += spec.factorizations
             if spec.stable:
-                if res <= opt.rtol:
+                if res <= rtol:
                     status = Status.CONVERGED
                     break
                 stall_checked = True
@@ -287,7 +290,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         d = obj.project(d)
         slope = _dot(g, d)
         dec = -0.5 * slope / escale
-        if dec <= opt.decrement_tol and res <= 1e3 * opt.rtol:
+        if dec <= opt.decrement_tol and res <= 1e3 * rtol:
             if pure:
                 # the energy is flat to round-off: take the whole step without a line search;
                 # only the residual test at the top may accept the point
@@ -298,7 +301,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 new = float(_norm(w * g)) / fscale
                 history.append((f, new, 1.0, shift))
                 floor_steps = floor_steps + 1 if new >= 0.5 * res else 0
-                if floor_steps >= 3 and new > opt.rtol:
+                if floor_steps >= 3 and new > rtol:
                     status, res = Status.STALLED, new
                     break
                 continue
@@ -345,7 +348,14 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             "newton %d: E=%.6e res=%.3e alpha=%.3g shift=%.3g", it, f, history[-1][1], alpha, shift
         )
     res = float(_norm(w * g)) / fscale
-    return _result(x, status, it, n_fact, f, res, dec, history, spec, escapes)
+    floor = _residual_floor(obj) / fscale
+    return _result(x, status, it, n_fact, f, res, dec, history, spec, escapes, floor)
+
+
+def _residual_floor(obj: Objective) -> float:
+    """The objective's estimate of the gradient's round-off floor (0 when it has none)."""
+    floor = getattr(obj, "residual_floor", None)
+    return 0.0 if floor is None else float(floor())
 
 
 def _certify(obj: Objective, H: Any, opt: NewtonOptions) -> Spectrum:
@@ -375,7 +385,9 @@ def _leave_saddle(obj, x, f, g, v, lam, armijo):  # type: ignore[no-untyped-def]
     for _ in range(30):
         best = None
         for sgn in (1.0, -1.0):
-            xt = obj.retract(x, sgn * v, a)
+            # never beyond the objective's step bound (e.g. contact's collision-free step)
+            d = sgn * a * v
+            xt = obj.retract(x, d, min(1.0, obj.max_step(x, d)))
             ft = obj.evaluate(xt, False, False)[0]
             bound = f + armijo * (sgn * a * gv + 0.5 * a * a * lam)
             if np.isfinite(ft) and ft <= bound and (best is None or ft < best[1]):
@@ -427,9 +439,12 @@ def _scale_curvature_step(obj, x, v, d, M):  # type: ignore[no-untyped-def]
     return scale * v
 
 
-def _result(x, status, it, n_fact, f, res, dec, history, spec=None, escapes=0) -> NewtonResult:  # type: ignore[no-untyped-def]
+def _result(
+    x, status, it, n_fact, f, res, dec, history, spec=None, escapes=0, floor=0.0
+) -> NewtonResult:  # type: ignore[no-untyped-def]
     certified = spec is not None and status is Status.CONVERGED
     return NewtonResult(
+        residual_floor=float(floor),
         stable=spec.stable if certified else None,  # type: ignore[union-attr]
         eigenvalues=spec.eigenvalues if certified else np.zeros(0),  # type: ignore[union-attr]
         modes=spec.modes if certified else None,  # type: ignore[union-attr]

@@ -221,6 +221,11 @@ class RodObjective:
         wt = np.ones(lay.count)
         wt[lay.theta] = 1.0 / lmean
         self._weights = wt[self.free]
+        # forces per unit of position round-off: axial EA / l and bending B / (l_vor l^2)
+        ea = cast(FloatArray, self.model.axial_stiffness)
+        self._roundoff_stiffness = float(
+            np.sqrt(np.sum((ea / rest) ** 2) + np.sum((stiff / self._vor**3) ** 2))
+        )
 
     # ------------------------------------------------------------------ state handling
     def set_base(self, state: State) -> None:
@@ -472,6 +477,23 @@ class RodObjective:
         x = self.base.positions
         arm = np.linalg.norm(x - m @ x / m.sum(), axis=1)
         return 2.0 * float(force @ arm) / max(float(m @ arm**2), 1e-300)
+
+    def residual_floor(self) -> float:
+        """Round-off floor of the weighted gradient norm at the base (N).
+
+        Positions carry a relative round-off of ``eps``; an edge vector of length ``l`` far
+        from the origin is known to ``eps |x|``, so a stretching force ``EA (|e|/l0 - 1)`` to
+        ``EA eps |x| / l`` and a bending force to ``B eps |x| / (l_vor l^2)``. Their root sum
+        of squares, times a safety factor 8, is the smallest residual the arithmetic resolves:
+        a nearly inextensible rod far from the origin cannot reach a tighter ``rtol``.
+        """
+        x = float(np.abs(self.base.positions).max())
+        return (
+            8.0
+            * float(np.finfo(float).eps)
+            * max(x, self.length_scale)
+            * (self._roundoff_stiffness)
+        )
 
     def curvature_step_scale(self, q: FloatArray, v: FloatArray) -> float:
         """Multiple of ``v`` that turns the most-turned edge by 0.2 rad."""

@@ -53,6 +53,9 @@ class NewtonResult:
         Their eigenvectors ``(n, k)`` when asked for (``NewtonOptions.keep_modes``).
     escapes
         Steps taken along a direction of negative curvature from an unstable equilibrium.
+    residual_floor
+        The objective's estimate of the residual's round-off floor (relative, like
+        ``residual``); convergence means ``residual <= max(rtol, residual_floor)``.
     """
 
     x: FloatArray
@@ -67,6 +70,7 @@ class NewtonResult:
     eigenvalues: FloatArray = field(default_factory=lambda: np.zeros(0))
     modes: FloatArray | None = None
     escapes: int = 0
+    residual_floor: float = 0.0
 
     @property
     def converged(self) -> bool:
