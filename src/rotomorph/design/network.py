@@ -96,6 +96,39 @@ class Network:
         edges = np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)
         return cls(pts, edges)
 
+    @classmethod
+    def ring(cls, points: FloatArray) -> Network:
+        """A closed filament (a ring) through ``points`` ``(N, 3)`` (mm), ``N >= 3``.
+
+        Segment ``j`` joins point ``j`` to point ``j + 1`` and the last one joins the last point
+        back to the first (do not repeat the first point at the end). Every node, the first
+        included, is an ordinary rod vertex whose incoming segment is the one before it, so a
+        ring has ``N`` segments and ``N`` bend–twist stencils (stencil ``k`` at node ``k``).
+        """
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 3:
+            raise InvalidDesignError(
+                "points", f"a ring needs an (N, 3) array with N >= 3; got shape {pts.shape}"
+            )
+        n = len(pts)
+        if np.linalg.norm(pts[-1] - pts[0]) <= 1e-12 * max(1.0, float(np.abs(pts).max())):
+            raise InvalidDesignError(
+                "points", "the last point repeats the first; a ring closes by itself, drop it"
+            )
+        edges = np.stack([np.arange(n), (np.arange(n) + 1) % n], axis=1)
+        return cls(pts, edges)
+
+    @property
+    def is_ring(self) -> bool:
+        """True for a single closed filament as made by :meth:`ring`."""
+        n = self.n_nodes
+        return (
+            self.n_edges == n
+            and not self.branch.any()
+            and np.array_equal(self.edges[:, 0], np.arange(n))
+            and np.array_equal(self.edges[:, 1], (np.arange(n) + 1) % n)
+        )
+
     @property
     def n_nodes(self) -> int:
         """Number of nodes."""

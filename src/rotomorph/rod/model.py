@@ -52,6 +52,8 @@ def _default_directors(network: Network) -> FloatArray:
     )
     if is_chain:
         return space_parallel_directors(network.nodes)
+    if network.is_ring:  # transported once around the loop; the closing vertex takes the rest
+        return space_parallel_directors(np.vstack([network.nodes, network.nodes[:1]]))
     t = network.nodes[e[:, 1]] - network.nodes[e[:, 0]]
     t /= np.linalg.norm(t, axis=1, keepdims=True)
     ref = np.where(np.abs(t[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
@@ -286,3 +288,15 @@ class Model:
     def chain(cls, points: FloatArray, **kwargs: object) -> Model:
         """A single filament through ``points`` ``(N, 3)`` (mm); keywords as for :class:`Model`."""
         return cls(Network.chain(points), **kwargs)  # type: ignore[arg-type]
+
+    @classmethod
+    def ring(cls, points: FloatArray, **kwargs: object) -> Model:
+        """A closed filament through ``points`` ``(N, 3)`` (mm), the last joined to the first.
+
+        Keywords as for :class:`Model`; per-stencil natural fields have ``N`` entries, entry
+        ``k`` at node ``k`` (a chain has ``N - 2``, at its interior nodes). The default
+        directors are transported parallel along the loop from the first segment; where they
+        return to it rotated (the loop's holonomy), the closing vertex's reference twist carries
+        the difference, so the printed ring is stress-free with the default natural twist.
+        """
+        return cls(Network.ring(points), **kwargs)  # type: ignore[arg-type]

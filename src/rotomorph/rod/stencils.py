@@ -94,7 +94,7 @@ def _build_stencils(network: Network) -> Stencils:
                 f"node {n} joins {k} segments but is not flagged as a branch node",
             )
         pairs = (
-            [(inc[0], inc[1])]
+            [_rod_vertex_pair(edges, n, inc[0], inc[1])]
             if k == 2 and not network.branch[n]
             else [(inc[p], inc[q]) for p in range(k) for q in range(p + 1, k)]
         )
@@ -117,6 +117,18 @@ def _build_stencils(network: Network) -> Stencils:
         sign_f=np.array([r[6] for r in rows]),
         junction=np.array([r[7] for r in rows], dtype=bool),
     )
+
+
+def _rod_vertex_pair(edges: IntArray, n: int, a: int, b: int) -> tuple[int, int]:
+    """Order the two segments of a rod vertex so that one pointing into the node comes first.
+
+    Segments are listed by index, so where a ring closes (node 0 of ``Network.ring``: segment 0
+    leaves it, the last segment enters it) the pair would otherwise be seen reversed on both
+    sides; ordered, the closing vertex is a vertex like any other, with the ring's orientation.
+    """
+    if edges[a, 1] != n and edges[b, 1] == n:
+        return b, a
+    return a, b
 
 
 @dataclass(frozen=True, eq=False)
