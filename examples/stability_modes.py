@@ -1,0 +1,139 @@
+"""Stability and eigenmodes
+=========================
+
+Is an equilibrium stable, and how does it lose stability? Three cases with exact answers:
+
+1. a perfectly straight clamped–free column under 3x its Euler load: the straight state is an
+   equilibrium (by symmetry the gradient vanishes) but a saddle; ``solve_static`` certifies every
+   exit point, leaves the saddle along its negative-curvature mode and finds the buckled elastica,
+   whose tip is compared with the elliptic-integral solution;
+2. the same column held straight: the lowest eigenvalue of the tangent stiffness crosses zero at
+   the Euler load ``pi^2 B / (4 L^2)``;
+3. a closed ring of a naturally straight rod with natural twist: flat and stable below Michell's
+   critical twist ``tau R = sqrt(3) B / C``, unstable above (its lowest mode leaves the plane).
+
+Run: ``python examples/stability_modes.py [--nodes N]``. Prints one JSON object per line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
+
+from rotomorph.rod.model import Model
+from rotomorph.solve.loads import Loads, Supports
+from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.stability import stability
+from rotomorph.solve.static import solve_static
+
+YOUNG, RADIUS, LENGTH = 1.0, 0.3, 10.0  # MPa, mm, mm
+BENDING = YOUNG * np.pi * RADIUS**4 / 4  # B, N mm^2
+TWIST = BENDING / 1.3  # C = G J with Poisson's ratio 0.3, N mm^2
+EULER = np.pi**2 * BENDING / (4 * LENGTH**2)  # clamped-free Euler load, N
+
+
+def column(n: int) -> Model:
+    """A straight column; its clamped first edge is centred on the origin (the clamp)."""
+    h = LENGTH / (n - 1.5)
+    s = -h / 2 + h * np.arange(n)
+    return Model.chain(
+        np.c_[s, 0 * s, 0 * s],
+        bending_stiffness1=BENDING,
+        bending_stiffness2=BENDING,
+        twist_stiffness=TWIST,
+        axial_stiffness=100 * YOUNG * np.pi * RADIUS**2,  # nearly inextensible
+    )
+
+
+def elastica_tip(ratio: float) -> tuple[float, float]:
+    """Tip (x, lateral) / L of the clamped-free elastica at ``ratio`` x the Euler load."""
+    big_k = np.sqrt(ratio) * np.pi / 2  # sqrt(P/B) L = K(k)
+    m = brentq(lambda m: ellipk(m) - big_k, 1e-12, 1 - 1e-14)
+    return 2 * ellipe(m) / big_k - 1, 2 * np.sqrt(m) / big_k
+
+
+def buckled_column(n: int) -> dict:
+    """Case 1: exactly straight start at 3x the Euler load."""
+    loads = Loads(forces=[(n - 1, (-3 * EULER, 0.0, 0.0))])
+    res = solve_static(column(n), Supports.clamp_ends(n), loads)
+    x_ref, y_ref = elastica_tip(3.0)
+    return {
+        "case": "euler_column_3x",
+        "n_nodes": n,
+        "stable": res.stable,
+        "escapes": res.escapes,
+        "iterations": res.iterations,
+        "tip_x_over_L": res.positions[-1, 0] / LENGTH,
+        "tip_x_over_L_elastica": x_ref,
+        "tip_deflection_over_L": float(np.hypot(*res.positions[-1, 1:])) / LENGTH,
+        "tip_deflection_over_L_elastica": y_ref,
+        "lowest_eigenvalues": res.eigenvalues.tolist(),
+    }
+
+
+def euler_load(n: int) -> dict:
+    """Case 2: the zero crossing of the straight column's lowest eigenvalue."""
+    model, supports = column(n), Supports.clamp_ends(n)
+    ratios, lowest = (0.9, 1.1), []
+    for f in ratios:
+        loads = Loads(forces=[(n - 1, (-f * EULER, 0.0, 0.0))])
+        # hold it straight: without the stability check the solver stays on the symmetric state
+        straight = solve_static(
+            model, supports, loads, options=NewtonOptions(check_stability=False)
+        )
+        lowest.append(stability(model, straight.state, supports, loads, count=1).eigenvalues[0])
+    crossing = ratios[0] + (ratios[1] - ratios[0]) * lowest[0] / (lowest[0] - lowest[1])
+    return {
+        "case": "euler_load_from_tangent_stiffness",
+        "n_nodes": n,
+        "lowest_eigenvalue_at_0.9": lowest[0],
+        "lowest_eigenvalue_at_1.1": lowest[1],
+        "critical_load_over_euler": crossing,
+    }
+
+
+def michell_ring(n: int) -> dict:
+    """Case 3: a twisted ring just below and just above Michell's critical twist."""
+    radius = 5.0
+    phi = 2 * np.pi * np.arange(n) / n
+    ring = Model.ring(
+        np.c_[radius * np.cos(phi), radius * np.sin(phi), 0 * phi],
+        bending_stiffness1=BENDING,
+        bending_stiffness2=BENDING,
+        twist_stiffness=TWIST,
+        axial_stiffness=100 * YOUNG * np.pi * RADIUS**2,
+    )
+    critical = np.sqrt(3) * BENDING / (TWIST * radius)  # natural twist, 1/mm
+    zero = np.zeros(n)
+    out: dict = {"case": "michell_ring", "n_nodes": n, "critical_twist_per_mm": critical}
+    for f in (0.9, 1.1):
+        twisted = ring.with_natural(
+            curvature1=zero, curvature2=zero, twist=np.full(n, f * critical)
+        )
+        res = stability(twisted, count=3)
+        # an isotropic ring has one neutral mode (every material frame turned alike about the
+        # centre line, no motion of the nodes); report the lowest mode that is not it
+        scale = np.abs(res.eigenvalues).max()
+        k = int(np.flatnonzero(np.abs(res.eigenvalues) > 1e-8 * scale)[0])
+        mode = res.modes.displacements[k]
+        out[f"stable_at_{f}"] = res.stable
+        out[f"lowest_eigenvalue_at_{f}"] = float(res.eigenvalues[k])
+        out[f"mode_out_of_plane_at_{f}"] = bool(np.abs(mode[:, 2]).max() > 0.5 * np.abs(mode).max())
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--nodes", type=int, default=41, help="nodes per rod (>= 8)")
+    args = parser.parse_args(argv)
+    for row in (buckled_column(args.nodes), euler_load(args.nodes), michell_ring(args.nodes)):
+        print(json.dumps(row))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
