@@ -20,7 +20,7 @@ def dome():
 
 def test_flat_dome_without_noise_rises_and_every_step_is_stable(dome):
     flat = heat_lattice(dome, steps=4, perturbation=0.0)
-    assert flat.stable.all()
+    assert all(flat.stable)
     assert (flat.gaussian_sign[1:] == 1).all()
     assert np.isfinite(flat.lowest_eigenvalue[1:]).all() and (flat.lowest_eigenvalue[1:] > 0).all()
     # the same dome as from the default perturbed start (up to which side it rises to)
@@ -36,4 +36,4 @@ def test_without_the_check_the_flat_saddle_point_is_returned(dome):
     plain = replace(RAMP_OPTIONS, check_stability=False)
     flat = heat_lattice(dome, steps=4, perturbation=0.0, options=plain)
     assert (flat.gaussian_sign == 0).all() and np.ptp(flat.positions[-1][:, 2]) == 0.0
-    assert not flat.stable[1:].any()
+    assert not any(flat.stable[1:])
