@@ -9,6 +9,7 @@ Commands::
     rotomorph view RUN [-o FILE.html]         interactive 3-D viewer of a run (needs plotly)
     rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
     rotomorph sweep SWEEP.toml -o DIR         parameter study (resumable; --scheduler for Dask)
+    rotomorph inverse TARGET.toml -o DESIGN.toml   print program for a target shape
 
 Exit codes: 0 success; 1 the computation failed (solver did not converge);
 2 bad input (command line, design file, machine limits, missing file, existing output folder).
@@ -308,6 +309,21 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_inverse(args: argparse.Namespace) -> int:
+    from rotomorph.inverse.run import inverse_file
+
+    target = _existing_file(args.target, "TARGET")
+    out = Path(args.output)
+    if not args.output or out.suffix != ".toml":
+        raise UsageError("-o/--output: give the design file to write, ending in .toml")
+    if out.exists() and not args.force:
+        raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
+    with _progress(0, "inverse") as bar:
+        text = inverse_file(target, out, progress=lambda it, j: bar.update(1))
+    _print(text)
+    return EXIT_OK
+
+
 # ----------------------------------------------------------------------------- parser
 
 
@@ -408,6 +424,18 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("sweep", help="run a parameter study", description=command.__doc__)
     add_arguments(p)
     p.set_defaults(func=command)
+
+    p = sub.add_parser(
+        "inverse",
+        help="design a print program for a target shape",
+        description="Inverse design: a target curve, dome, saddle or height map (TOML) -> a "
+        "design file, verified by forward simulation, with figures and summary.json in "
+        "<DESIGN>_inverse/.",
+    )
+    p.add_argument("target", metavar="TARGET.toml")
+    p.add_argument("-o", "--output", required=True, metavar="DESIGN.toml")
+    p.add_argument("--force", action="store_true", help="replace an existing design file")
+    p.set_defaults(func=_cmd_inverse)
     return parser
 
 

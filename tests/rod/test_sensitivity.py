@@ -22,7 +22,9 @@ def _junction_network() -> Network:
 
 def _with_integrated(model: Model, k1, k2, tw, rest) -> Model:
     trial = model.with_natural(rest_length=rest)
-    v = trial.voronoi_length
+    # whatever length the model integrates pointwise values over: measure it
+    ones = np.ones(trial.stencils.count)
+    v = trial.with_natural(curvature1=ones).integrated_natural()[0]
     return trial.with_natural(curvature1=k1 / v, curvature2=k2 / v, twist=tw / v)
 
 

@@ -59,9 +59,7 @@ def resample(points: FloatArray, spacing: float) -> FloatArray:
         raise InvalidDesignError("target.spacing", f"must be > 0 mm; got {spacing}")
     spline = CubicSpline(s, pts, axis=0)
     fine = np.linspace(0.0, s[-1], 20 * len(pts) + 1)
-    arc = np.concatenate(
-        [[0.0], np.cumsum(np.linalg.norm(np.diff(spline(fine), axis=0), axis=1))]
-    )
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(spline(fine), axis=0), axis=1))])
     n = max(int(np.ceil(arc[-1] / spacing)) + 1, 3)
     return spline(np.interp(np.linspace(0.0, arc[-1], n), arc, fine))
 
@@ -88,7 +86,9 @@ def self_intersection(points: FloatArray, diameter: float) -> tuple[int, int, fl
     return None
 
 
-def _segment_distances(p0: FloatArray, p1: FloatArray, q0: FloatArray, q1: FloatArray) -> FloatArray:
+def _segment_distances(
+    p0: FloatArray, p1: FloatArray, q0: FloatArray, q1: FloatArray
+) -> FloatArray:
     """Distances between segment p0p1 and each segment q0[k]q1[k] (closest points, clamped)."""
     d1 = p1 - p0
     d2 = q1 - q0
@@ -99,7 +99,9 @@ def _segment_distances(p0: FloatArray, p1: FloatArray, q0: FloatArray, q1: Float
     c = r @ d1
     b = d2 @ d1
     denom = a * e - b * b
-    s = np.where(denom > 1e-14, np.clip((b * f - c * e) / np.where(denom > 1e-14, denom, 1), 0, 1), 0.0)
+    s = np.where(
+        denom > 1e-14, np.clip((b * f - c * e) / np.where(denom > 1e-14, denom, 1), 0, 1), 0.0
+    )
     t = (b * s + f) / e
     t = np.clip(t, 0.0, 1.0)
     s = np.clip((b * t - c) / a, 0.0, 1.0)

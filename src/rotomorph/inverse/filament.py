@@ -271,7 +271,9 @@ def design_filament(
     over = np.abs(omega_v) * speed_v / radius > max_rotation * (1 + 1e-9)
     notes: list[str] = []
     if over.any():
-        omega_v = np.clip(omega_v, -radius * max_rotation / speed_v, radius * max_rotation / speed_v)
+        omega_v = np.clip(
+            omega_v, -radius * max_rotation / speed_v, radius * max_rotation / speed_v
+        )
         reachable = reachable & ~over
         notes.append(f"{int(over.sum())} vertices need a rotation above {max_rotation:g} rad/s")
     side_v = np.where(geo.curvature < 0.0, -1.0, 1.0)

@@ -170,7 +170,9 @@ def response_table(
     twist = (tw[st] / vor_p[st]).reshape(vv.shape)
     stretch = (rest[centre] / printed[centre]).reshape(vv.shape)
     # the directors are signed without pi jumps; the block's sign is that of its centre edge
-    sign = np.sign(np.einsum("ij,ij->i", field.directors[centre], program.interface_normals[centre]))
+    sign = np.sign(
+        np.einsum("ij,ij->i", field.directors[centre], program.interface_normals[centre])
+    )
     curvature = curvature * sign.reshape(vv.shape)
     return ResponseTable(
         speeds=speeds,

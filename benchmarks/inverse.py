@@ -1,0 +1,146 @@
+"""Inverse design benchmark: one JSON line per case.
+
+Cases: ``filament-spiral`` (planar spiral), ``filament-perversion`` (tendril-like curve whose
+handedness reverses), ``lattice-dome`` and ``lattice-saddle`` (5 × 5 paper lattice, adjoint
+optimisation of the per-edge modes, then rounding to printable modes and a fresh forward
+verification). Fields: ``case``, ``n_design_variables``, ``iterations``, ``wall_s``,
+``rms_error_rel`` (filaments: RMS centre-line error / length; lattices: RMS height misfit /
+lattice size), ``target_metric`` and ``achieved_metric`` (filaments: mean |curvature| of the
+target and of the simulated design, 1/mm; lattices: Gaussian curvature K, 1/mm²),
+``gradient_fd_rel_err`` (lattices: adjoint gradient vs central differences on three edges;
+filaments: null, their design is direct), ``reachable`` / ``stable`` flags.
+
+Targets: filament cases ≤ 5 s (the material response table is built once per session and
+reported separately as ``response-table``), 5 × 5 lattice cases ≤ 60 s on one core.
+
+Run: ``python benchmarks/inverse.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from rotomorph.analysis.curvature import discrete_curvature
+from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.inverse.adjoint import adjoint
+from rotomorph.inverse.filament import design_filament
+from rotomorph.inverse.lattice import (
+    _Equilibria,
+    design_lattice,
+    dome,
+    lattice_blend,
+    saddle,
+    surface_misfit,
+)
+from rotomorph.inverse.response import response_table
+from rotomorph.inverse.targets import CurveSpec, curve_points
+
+
+def _emit(**row: object) -> None:
+    print(json.dumps(row), flush=True)
+
+
+def filament_case(name: str, spec: CurveSpec, table) -> None:  # type: ignore[no-untyped-def]
+    t0 = time.perf_counter()
+    des = design_filament(curve_points(spec), spacing=0.1, table=table)
+    wall = time.perf_counter() - t0
+    _emit(
+        case=name,
+        n_design_variables=2 * len(des.speed),
+        iterations=1,
+        wall_s=round(wall, 3),
+        rms_error_rel=des.rms_error_rel,
+        target_metric=float(np.mean(discrete_curvature(des.target))),
+        achieved_metric=float(np.mean(discrete_curvature(des.achieved))),
+        gradient_fd_rel_err=None,
+        reachable=des.fully_reachable,
+        unreachable_mm=des.unreachable_stretches(),
+    )
+
+
+def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
+    blend = lattice_blend(lattice)
+    eq = _Equilibria(blend)
+    c = np.array([0.8 if m == "expanding" else -0.8 for m in lattice.edge_mode])
+    size = lattice.spacing * (lattice.n - 1)
+    res = eq(c)
+    _, gx, _ = surface_misfit(res.positions, target, size)
+    model = blend.rod(c)
+    lay = model.layout
+    dj = np.zeros(lay.count)
+    dj[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
+    s = adjoint(model, res.state, dj).sensitivity
+    dk, dl = blend.derivative()
+    g = np.zeros(blend.n_edges)
+    mask = blend.stencil_edge >= 0
+    prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1) * dk
+    np.add.at(g, blend.stencil_edge[mask], prod[mask].sum(axis=1))
+    np.add.at(g, blend.segment_edge, s.rest_length * dl)
+    g = -g
+    worst = 0.0
+    h = 1e-4
+    for e in (0, 13, 27):
+        vals = []
+        for sgn in (1, -1):
+            cc = c.copy()
+            cc[e] += sgn * h
+            eq.last = (c, res.state)
+            vals.append(surface_misfit(eq(cc).positions, target, size)[0])
+        fd = (vals[0] - vals[1]) / (2 * h)
+        worst = max(worst, abs(g[e] - fd) / max(abs(fd), 1e-300))
+    return worst
+
+
+def lattice_case(name: str, pattern: str, target, iterations: int) -> None:  # type: ignore[no-untyped-def]
+    lat = sinusoidal_lattice(n=5, spacing=5.0, amplitude=1.25, ghost_nodes=10, pattern=pattern)
+    t0 = time.perf_counter()
+    des = design_lattice(lat, target, max_iterations=iterations)
+    wall = time.perf_counter() - t0
+    _emit(
+        case=name,
+        n_design_variables=len(des.modes),
+        iterations=des.iterations,
+        wall_s=round(wall, 3),
+        rms_error_rel=des.misfit_rel,
+        target_metric=des.target_gaussian_curvature,
+        achieved_metric=des.achieved_gaussian_curvature,
+        gaussian_curvature_error_rel=abs(
+            abs(des.achieved_gaussian_curvature) - abs(des.target_gaussian_curvature or 0.0)
+        )
+        / abs(des.target_gaussian_curvature or 1.0),
+        gradient_fd_rel_err=_fd_check(lat, target),
+        stable=des.stable,
+        forward_solves=des.solves,
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer optimiser iterations")
+    args = parser.parse_args()
+    t0 = time.perf_counter()
+    table = response_table(max_omega_star=1.5)
+    _emit(case="response-table", wall_s=round(time.perf_counter() - t0, 3))
+    kmin, kmax = (float(np.min(np.abs(table.curvature))), float(np.max(np.abs(table.curvature))))
+    r_lo, r_hi = 1.0 / (0.9 * kmax), 1.0 / (1.2 * kmin)
+    filament_case(
+        "filament-spiral",
+        CurveSpec(family="spiral", radius_start=r_lo, radius_end=max(r_hi, r_lo + 1.5), turns=1.0),
+        table,
+    )
+    filament_case(
+        "filament-perversion",
+        CurveSpec(family="tendril", radius=0.5 * (r_lo + r_hi), pitch=1.5, turns=1.0),
+        table,
+    )
+    its = 6 if args.quick else 20
+    lattice_case("lattice-dome", "dome", dome(0.02), its)
+    lattice_case("lattice-saddle", "saddle", saddle(0.02), its)
+
+
+if __name__ == "__main__":
+    main()

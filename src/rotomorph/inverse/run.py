@@ -1,0 +1,260 @@
+"""Run an inverse design from a target file: design, verification, design file, figures, summary.
+
+:func:`run_inverse` returns an :class:`InverseRun` (the printable design as a design-file model
+that ``rotomorph validate``, ``simulate`` and ``gcode`` accept unchanged, the verification
+numbers and a convergence log); :func:`write_inverse` writes the design file and, in a folder
+beside it, ``summary.json``, ``convergence.csv`` and the figures.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.inverse.filament import FilamentDesign, design_filament
+from rotomorph.inverse.lattice import LatticeDesign, design_lattice
+from rotomorph.inverse.targets import TargetFile, curve_points
+from rotomorph.io.atomic import atomic_write_text
+from rotomorph.io.designfile import Design, parse_design, save_design
+
+__all__ = [
+    "InverseRun",
+    "filament_design_file",
+    "inverse_file",
+    "lattice_design_file",
+    "run_inverse",
+    "write_inverse",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class InverseRun:
+    """Outcome of an inverse design run.
+
+    Attributes
+    ----------
+    target
+        The validated target file.
+    design
+        The printable design (a validated design-file model).
+    summary
+        JSON-ready numbers: target and achieved metrics, errors, reachability, settings.
+    log
+        Convergence log rows ``(iteration, objective)``.
+    result
+        The :class:`FilamentDesign` or :class:`LatticeDesign`.
+    """
+
+    target: TargetFile
+    design: Design
+    summary: dict[str, Any]
+    log: list[tuple[int, float]] = field(default_factory=list)
+    result: FilamentDesign | LatticeDesign | None = None
+
+
+def _groups(values: FloatArray, tol: FloatArray) -> list[tuple[int, int]]:
+    """Runs ``[start, end)`` of consecutive rows of ``values`` equal within ``tol``."""
+    out = []
+    i = 0
+    while i < len(values):
+        j = i + 1
+        while j < len(values) and np.all(np.abs(values[j] - values[i]) <= tol):
+            j += 1
+        out.append((i, j))
+        i = j
+    return out
+
+
+def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Design:
+    """The design file of a designed filament: line segments of constant speed and rotation.
+
+    Each segment carries the speed of its moves and the rotation number that turns the nozzle
+    by exactly the program's nozzle-angle change over it, so the file reproduces the program.
+    """
+    prog = design.program
+    pts = np.asarray(prog.points)
+    seg_len = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    d_angle = np.diff(np.asarray(prog.nozzle_angle))
+    rate = d_angle / seg_len  # nozzle-angle change per printed length (rad/mm)
+    speed = np.asarray(prog.speed)[:-1]
+    rows = np.stack([speed, rate], axis=1)
+    tol = np.array([1e-6 * max(float(np.max(speed)), 1.0), 1e-9 + 1e-6 * np.max(np.abs(rate))])
+    segments = []
+    for a, b in _groups(rows, tol):
+        length = float(seg_len[a:b].sum())
+        value = float(d_angle[a:b].sum() * prog.radius / length)
+        segments.append(
+            {
+                "kind": "line",
+                "length": length,
+                "speed": float(np.mean(speed[a:b])),
+                "rotation_number": value,
+            }
+        )
+    spacing = float(np.max(seg_len)) * (1.0 + 1e-6)
+    data = {
+        "schema_version": 1,
+        "name": name,
+        "description": "designed by rotomorph inverse (straight print path; heats into the target)",
+        "filaments": [
+            {
+                "name": name,
+                "speed": float(speed[0]),
+                "spacing": spacing,
+                "radius": float(prog.radius),
+                "active_fraction": float(prog.active_fraction),
+                "initial_nozzle_angle_deg": math.degrees(float(prog.nozzle_angle[0])),
+                "segments": segments,
+            }
+        ],
+    }
+    return parse_design(data)
+
+
+def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
+    """The design file of a designed lattice (``pattern = "custom"`` with per-edge modes)."""
+    lat = design.lattice
+    data = {
+        "schema_version": 1,
+        "name": name,
+        "description": f"designed by rotomorph inverse for {design.target.description}",
+        "lattice": {
+            "n": lat.n,
+            "spacing": lat.spacing,
+            "amplitude": lat.amplitude,
+            "ghost_nodes": lat.ghost_nodes,
+            "pattern": "custom",
+            "edge_modes": ["expanding" if m > 0 else "contracting" for m in design.modes],
+        },
+    }
+    return parse_design(data)
+
+
+def run_inverse(
+    target: TargetFile, progress: Callable[[int, float], None] | None = None
+) -> InverseRun:
+    """Design, verify and package the print program for a target (module docstring)."""
+    opt = target.options
+    name = target.name or target.kind
+    if target.kind == "curve":
+        assert target.curve is not None
+        fil = design_filament(
+            curve_points(target.curve),
+            spacing=opt.spacing,
+            radius=opt.radius,
+            temperature=opt.temperature,
+            speed_range=(opt.min_speed, opt.max_speed),
+            max_rotation=opt.max_rotation,
+        )
+        summary: dict[str, Any] = {
+            "kind": "curve",
+            "family": target.curve.family,
+            "length_mm": float(np.sum(np.linalg.norm(np.diff(fil.target, axis=0), axis=1))),
+            "rms_error_mm": fil.rms_error,
+            "rms_error_rel": fil.rms_error_rel,
+            "fully_reachable": fil.fully_reachable,
+            "unreachable_stretches_mm": fil.unreachable_stretches(),
+            "flips": fil.flips,
+            "speed_range_mm_s": [float(fil.speed.min()), float(fil.speed.max())],
+            "omega_star_range": [float(fil.omega_star.min()), float(fil.omega_star.max())],
+            "notes": fil.notes,
+            "verified_by": "forward simulation of the designed program (free filament)",
+        }
+        return InverseRun(target, filament_design_file(fil, name), summary, [], fil)
+    assert target.lattice is not None
+    spec = target.lattice
+    lat = sinusoidal_lattice(
+        spec.n,
+        spec.spacing,
+        spec.amplitude,
+        spec.ghost_nodes,
+        pattern="dome" if target.kind != "saddle" else "saddle",
+    )
+    log: list[tuple[int, float]] = []
+
+    def cb(it: int, value: float) -> None:
+        log.append((it, value))
+        if progress is not None:
+            progress(it, value)
+
+    surf = target.surface_target()
+    des = design_lattice(lat, surf, max_iterations=opt.max_iterations, callback=cb)
+    k_t = des.target_gaussian_curvature
+    k_a = des.achieved_gaussian_curvature
+    summary = {
+        "kind": target.kind,
+        "lattice": {"n": spec.n, "spacing_mm": spec.spacing, "amplitude_mm": spec.amplitude},
+        "assumptions": "lattice spacing, amplitude and ghost nodes are design choices "
+        "(not given by the paper)",
+        "target_gaussian_curvature": k_t,
+        "achieved_gaussian_curvature": k_a,
+        "gaussian_curvature_error_rel": None
+        if k_t is None
+        else abs(abs(k_a) - abs(k_t)) / abs(k_t),
+        "misfit_rms_mm": des.misfit_rms,
+        "misfit_rel": des.misfit_rel,
+        "stable": des.stable,
+        "iterations": des.iterations,
+        "forward_solves": des.solves,
+        "expanding_edges": int(np.sum(des.modes > 0)),
+        "contracting_edges": int(np.sum(des.modes < 0)),
+    }
+    return InverseRun(target, lattice_design_file(des, name), summary, log, des)
+
+
+def write_inverse(run: InverseRun, design_path: str | Path) -> list[Path]:
+    """Write the design file and, in ``<design stem>_inverse/``, the summary, log and figures."""
+    from rotomorph.inverse.figures import inverse_figures
+
+    design_path = Path(design_path)
+    design_path.parent.mkdir(parents=True, exist_ok=True)
+    out = [save_design(run.design, design_path)]
+    folder = design_path.with_name(design_path.stem + "_inverse")
+    folder.mkdir(parents=True, exist_ok=True)
+    out.append(atomic_write_text(folder / "summary.json", json.dumps(run.summary, indent=2) + "\n"))
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["iteration", "objective"])
+    w.writerows(run.log)
+    out.append(atomic_write_text(folder / "convergence.csv", buf.getvalue()))
+    if run.result is not None:
+        out += inverse_figures(run.result, folder)
+    return out
+
+
+def inverse_file(
+    target_path: str | Path,
+    design_path: str | Path,
+    progress: Callable[[int, float], None] | None = None,
+) -> str:
+    """Run the target file at ``target_path`` and write the results; returns a one-line summary."""
+    from rotomorph.inverse.targets import load_target
+
+    target = load_target(str(target_path))
+    run = run_inverse(target, progress)
+    write_inverse(run, design_path)
+    s = run.summary
+    folder = Path(design_path).with_name(Path(design_path).stem + "_inverse")
+    if target.kind == "curve":
+        reach = "all reachable" if s["fully_reachable"] else "NOT all reachable (see summary)"
+        return (
+            f"wrote {design_path} and {folder}/: RMS error {s['rms_error_mm']:.3g} mm "
+            f"({100 * s['rms_error_rel']:.2g} % of the length), {reach}, {s['flips']} flips"
+        )
+    k_t, k_a = s["target_gaussian_curvature"], s["achieved_gaussian_curvature"]
+    kt = "" if k_t is None else f"target K {k_t:.3g} 1/mm², "
+    stable = "stable" if s["stable"] else "NOT STABLE"
+    return (
+        f"wrote {design_path} and {folder}/: {kt}achieved K {k_a:.3g} 1/mm², misfit "
+        f"{s['misfit_rms_mm']:.3g} mm ({100 * s['misfit_rel']:.2g} % of the size), {stable}"
+    )

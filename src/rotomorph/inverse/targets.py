@@ -1,0 +1,240 @@
+"""Target files of inverse design (TOML), validated like design files.
+
+A target file says what shape is wanted and, for lattices, the printed geometry to design on::
+
+    schema_version = 1
+    kind = "curve"                    # curve | dome | saddle | height_map
+    [curve]
+    family = "helix"                  # helix | spiral | tendril | points
+    radius_start = 2.0                # mm
+    radius_end = 2.6
+    pitch = 2.0                       # mm per turn
+    turns = 2.0
+
+Curve families (all lengths in mm):
+
+* ``helix``: radius varying linearly from ``radius_start`` to ``radius_end`` over ``turns``
+  turns of constant ``pitch`` (right-handed for ``pitch > 0``);
+* ``spiral``: a planar spiral whose radius goes from ``radius_start`` to ``radius_end`` over
+  ``turns`` turns;
+* ``tendril``: two helices of opposite handedness (radius, pitch, ``turns`` each) joined at a
+  perversion, as in a climbing plant's tendril;
+* ``points``: sampled points ``[[x, y, z], ...]``.
+
+Lattice targets (``dome``, ``saddle``, ``height_map``) give the curvatures (1/mm) or a height
+grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``amplitude``,
+``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+import numpy as np
+import tomllib
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from rotomorph._typing import FloatArray
+from rotomorph.errors import InvalidDesignError
+from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
+
+__all__ = ["TargetFile", "curve_points", "load_target", "parse_target"]
+
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+class CurveSpec(_Model):
+    """A target centre line."""
+
+    family: Literal["helix", "spiral", "tendril", "points"]
+    radius_start: Positive | None = None
+    radius_end: Positive | None = None
+    radius: Positive | None = None
+    pitch: float | None = Field(None, allow_inf_nan=False)
+    turns: Positive | None = None
+    points: list[tuple[float, float, float]] | None = None
+    samples_per_turn: int = Field(120, ge=16, le=2000)
+
+    @model_validator(mode="after")
+    def _fields(self) -> CurveSpec:
+        need = {
+            "helix": ("radius_start", "radius_end", "pitch", "turns"),
+            "spiral": ("radius_start", "radius_end", "turns"),
+            "tendril": ("radius", "pitch", "turns"),
+            "points": ("points",),
+        }[self.family]
+        missing = [k for k in need if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"family '{self.family}' needs {', '.join(missing)}")
+        if self.family == "points" and self.points is not None and len(self.points) < 3:
+            raise ValueError("points needs at least 3 points [[x, y, z], ...] (mm)")
+        return self
+
+
+class LatticeSpec(_Model):
+    """Printed lattice geometry to design on (assumed: the paper does not give it)."""
+
+    n: int = Field(5, ge=2, le=12)
+    spacing: Positive = 5.0
+    amplitude: float = Field(1.25, ge=0, allow_inf_nan=False)
+    ghost_nodes: int = Field(10, ge=2, le=40)
+
+
+class SurfaceSpec(_Model):
+    """Dome/saddle principal curvatures (1/mm, positive magnitudes)."""
+
+    curvature: Positive
+    curvature2: Positive | None = None
+
+
+class HeightMapSpec(_Model):
+    """Heights ``z[i][j]`` (mm) at ``(x[i], y[j])`` (mm), centred on the lattice."""
+
+    x: list[float] = Field(min_length=4)
+    y: list[float] = Field(min_length=4)
+    z: list[list[float]]
+
+
+class Options(_Model):
+    """Settings of the design run."""
+
+    spacing: Positive = 0.1
+    temperature: float = Field(175.0, ge=-50, le=300)
+    min_speed: Positive = 0.25
+    max_speed: Positive = 3.0
+    max_rotation: Positive = 40.0
+    max_iterations: int = Field(30, ge=1, le=500)
+    radius: Positive = 0.3
+
+
+class TargetFile(_Model):
+    """A validated target file."""
+
+    schema_version: Literal[1] = 1
+    kind: Literal["curve", "dome", "saddle", "height_map"]
+    name: str = Field("", max_length=200, pattern=r"^[^\x00-\x1f\x7f]*$")
+    curve: CurveSpec | None = None
+    surface: SurfaceSpec | None = None
+    height_map: HeightMapSpec | None = None
+    lattice: LatticeSpec | None = None
+    options: Options = Options()
+
+    @model_validator(mode="after")
+    def _tables(self) -> TargetFile:
+        table = {
+            "curve": "curve",
+            "dome": "surface",
+            "saddle": "surface",
+            "height_map": "height_map",
+        }[self.kind]
+        if getattr(self, table) is None:
+            raise ValueError(f"kind '{self.kind}' needs a [{table}] table")
+        if self.kind != "curve" and self.lattice is None:
+            raise ValueError(f"kind '{self.kind}' needs a [lattice] table (n, spacing, amplitude)")
+        if self.options.min_speed >= self.options.max_speed:
+            raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
+        return self
+
+    def surface_target(self) -> SurfaceTarget:
+        """The :class:`SurfaceTarget` of a lattice target."""
+        if self.kind == "dome":
+            assert self.surface is not None
+            return dome(self.surface.curvature, self.surface.curvature2)
+        if self.kind == "saddle":
+            assert self.surface is not None
+            return saddle(self.surface.curvature, self.surface.curvature2)
+        assert self.height_map is not None
+        hm = self.height_map
+        return height_map(np.array(hm.x), np.array(hm.y), np.array(hm.z))
+
+
+def curve_points(spec: CurveSpec) -> FloatArray:
+    """Points ``(M, 3)`` (mm) of a curve target."""
+    if spec.family == "points":
+        assert spec.points is not None
+        return np.array(spec.points, dtype=float)
+    turns = float(spec.turns)  # type: ignore[arg-type]
+    m = max(round(spec.samples_per_turn * turns), 16)
+    t = np.linspace(0.0, 2 * math.pi * turns, m + 1)
+    if spec.family == "helix":
+        r = np.linspace(spec.radius_start, spec.radius_end, len(t))  # type: ignore[arg-type]
+        z = float(spec.pitch) * t / (2 * math.pi)  # type: ignore[arg-type]
+        return np.stack([r * np.cos(t), r * np.sin(t), z], axis=1)
+    if spec.family == "spiral":
+        r = np.linspace(spec.radius_start, spec.radius_end, len(t))  # type: ignore[arg-type]
+        return np.stack([r * np.cos(t), r * np.sin(t), np.zeros_like(t)], axis=1)
+    # tendril: curvature and torsion both change sign through a smooth switch (a perversion):
+    # (kappa, tau) -> (-kappa, -tau) keeps the helix axis and the direction of advance along it
+    # and reverses the handedness (the sign of the torsion); the curve is straight at the joint
+    rad, p = float(spec.radius), float(spec.pitch)  # type: ignore[arg-type]
+    c = p / (2 * math.pi)
+    kappa = rad / (rad * rad + c * c)
+    tau = c / (rad * rad + c * c)
+    length = 2 * turns * 2 * math.pi * math.hypot(rad, c)
+    s = np.linspace(0.0, length, 2 * m + 1)
+    width = 0.05 * length
+    switch = np.tanh((0.5 * length - s) / width)
+    return _frenet_curve(kappa * switch, tau * switch, s)
+
+
+def _frenet_curve(kappa: FloatArray, tau: FloatArray, s: FloatArray) -> FloatArray:
+    """Integrate the Frenet–Serret equations (exact rotation per step, midpoint rates)."""
+    frame = np.eye(3)  # rows: tangent, normal, binormal
+    pts = np.zeros((len(s), 3))
+    for i in range(1, len(s)):
+        h = s[i] - s[i - 1]
+        k = 0.5 * (kappa[i] + kappa[i - 1])
+        t = 0.5 * (tau[i] + tau[i - 1])
+        darboux = t * frame[0] + k * frame[2]  # angular velocity of the frame
+        ang = float(np.linalg.norm(darboux)) * h
+        half = frame.copy()
+        if ang > 0:
+            axis = darboux / np.linalg.norm(darboux)
+            frame = _rotate(frame, axis, ang)
+            half = _rotate(half, axis, 0.5 * ang)
+        pts[i] = pts[i - 1] + h * half[0]
+    return pts
+
+
+def _rotate(vectors: FloatArray, axis: FloatArray, angle: float) -> FloatArray:
+    c, sn = math.cos(angle), math.sin(angle)
+    return vectors * c + np.cross(axis, vectors) * sn + np.outer(vectors @ axis, axis) * (1 - c)
+
+
+def _format(err: Any) -> tuple[str, str]:
+    loc = ".".join(str(p) for p in err["loc"]) or "<target>"
+    return loc, err["msg"].removeprefix("Value error, ")
+
+
+def parse_target(data: dict[str, Any]) -> TargetFile:
+    """Validate a mapping (parsed TOML) into a :class:`TargetFile`."""
+    if "schema_version" not in data:
+        raise InvalidDesignError("schema_version", "is required; add schema_version = 1")
+    try:
+        return TargetFile.model_validate(data)
+    except ValidationError as exc:
+        field, msg = _format(exc.errors()[0])
+        raise InvalidDesignError(field, msg) from None
+
+
+def load_target(path: str) -> TargetFile:
+    """Read and validate a TOML target file (UTF-8)."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise InvalidDesignError(str(path), f"cannot be read: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InvalidDesignError(str(path), "is not UTF-8 text; save it as UTF-8") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidDesignError(str(path), f"is not valid TOML: {exc}") from None
+    return parse_target(data)
