@@ -138,8 +138,8 @@ def main() -> None:
         table,
     )
     its = 6 if args.quick else 20
-    lattice_case("lattice-dome", "dome", dome(0.02), its)
-    lattice_case("lattice-saddle", "saddle", saddle(0.02), its)
+    lattice_case("lattice-dome", "dome", dome(0.024), its)
+    lattice_case("lattice-saddle", "saddle", saddle(0.07), its)
 
 
 if __name__ == "__main__":

@@ -387,13 +387,21 @@ class _Equilibria:
             self.solves += 1
             return solve_static(self.blend.rod(c, t), initial=state, options=SOLVE_OPTIONS)
 
-        res = None
-        for k in range(self.retries + 1):
-            path = continuation(solve, np.linspace(0.1, 1.0, 10), self._flat(5.0**k), start=0.0)
-            res = path.results[-1]
-            if _is_minimum(self.blend.rod(c), res.state):
+        path = continuation(solve, np.linspace(0.1, 1.0, 10), self._flat(1.0), start=0.0)
+        res = path.results[-1]
+        model = self.blend.rod(c)
+        lat = self.blend.lattice
+        for k in range(self.retries):
+            if _is_minimum(model, res.state):
                 break
-        assert res is not None
+            # a symmetric state past its buckling point: kick it out of plane and re-solve
+            kick = symmetry_breaking(lat, 5.0**k * self.perturbation * lat.spacing, self.seed + k)
+            start = perturbed_state(model, res.positions - lat.network.nodes)
+            start = perturbed_state(
+                model, start.positions - lat.network.nodes + kick[:, None] * [0.0, 0.0, 1.0]
+            )
+            self.solves += 1
+            res = solve_static(model, initial=start, options=SOLVE_OPTIONS)
         return res
 
     def __call__(self, c: FloatArray) -> StaticResult:
@@ -617,7 +625,34 @@ def design_lattice(
         c = opt.x
         nit += int(opt.nit)
     relaxed = np.clip(c, -1, 1)
-    modes = np.where(relaxed >= 0, 1.0, -1.0)
+
+    def verified(design: FloatArray) -> tuple[float, StaticResult]:
+        """Misfit of a printable design after a fresh ramp, as the forward simulation runs it."""
+        res = _Equilibria(blend, seed=seed)(design)
+        stable_here = _is_minimum(blend.rod(design), res.state)
+        value = surface_misfit(res.positions[picked], target, size)[0]
+        return (value if stable_here else np.inf), res
+
+    # rounding: the rounded optimum and the starting pattern, then single-edge flips while
+    # they lower the warm-started misfit (a discrete refinement of the printable design)
+    candidates = [np.where(relaxed >= 0, 1.0, -1.0), np.where(c0 >= 0, 1.0, -1.0)]
+    scored = [(verified(m), m) for m in candidates]
+    (best_j, best_res), modes = min(scored, key=lambda t: t[0][0])
+    local = _Equilibria(blend, seed=seed)
+    local.last = (modes, best_res.state)
+    for e in np.argsort(np.abs(relaxed)):  # least decided edges first
+        trial = modes.copy()
+        trial[e] = -trial[e]
+        try:
+            res = local(trial)
+        except ConvergenceError:
+            local.last = (modes, best_res.state)
+            continue
+        value = surface_misfit(res.positions[picked], target, size)[0]
+        if value < best_j and _is_minimum(blend.rod(trial), res.state):
+            modes, best_j, best_res = trial, value, res
+        else:
+            local.last = (modes, best_res.state)
     printed = _with_pattern(
         lattice, {e: ("expanding" if m > 0 else "contracting") for e, m in enumerate(modes)}
     )
@@ -642,5 +677,5 @@ def design_lattice(
         target_gaussian_curvature=target.gaussian_curvature,
         stable=stable,
         iterations=nit,
-        solves=eq.solves + verify.solves,
+        solves=eq.solves + verify.solves + local.solves,
     )
