@@ -125,11 +125,13 @@ def main() -> None:
     t0 = time.perf_counter()
     table = response_table(max_omega_star=1.5)
     _emit(case="response-table", wall_s=round(time.perf_counter() - t0, 3))
-    kmin, kmax = (float(np.min(np.abs(table.curvature))), float(np.max(np.abs(table.curvature))))
-    r_lo, r_hi = 1.0 / (0.9 * kmax), 1.0 / (1.2 * kmin)
+    # curvature per heated length without rotation, over the allowed speeds
+    k0 = np.abs(table.curvature[:, table.omega_stars.size // 2]) / table.stretch[:, 0]
+    kmin, kmax = float(k0.min()), float(k0.max())
+    r_lo, r_hi = 1.0 / (0.9 * kmax), 1.0 / (1.1 * kmin)
     filament_case(
         "filament-spiral",
-        CurveSpec(family="spiral", radius_start=r_lo, radius_end=max(r_hi, r_lo + 1.5), turns=1.0),
+        CurveSpec(family="spiral", radius_start=r_lo, radius_end=min(r_hi, r_lo + 3.0), turns=1.0),
         table,
     )
     filament_case(

@@ -31,7 +31,7 @@ from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.curve import CurveGeometry, curve_geometry, resample, self_intersection
-from rotomorph.inverse.response import ResponseTable, response_table
+from rotomorph.inverse.response import ResponseTable, cached_response_table
 from rotomorph.materials.natural import FilamentModel, natural_field
 from rotomorph.rod.model import Model
 from rotomorph.solve.static import solve_static
@@ -251,7 +251,7 @@ def design_filament(
     geo = curve_geometry(pts)
     if table is None:
         omega_cap = radius * max_rotation / speed_range[0]
-        table = response_table(
+        table = cached_response_table(
             speed_range=speed_range,
             max_omega_star=min(omega_cap, 2.5),
             radius=radius,

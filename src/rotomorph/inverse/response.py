@@ -30,7 +30,7 @@ from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.natural import FilamentModel, natural_field
 from rotomorph.rod.model import Model
 
-__all__ = ["ResponseTable", "response_table"]
+__all__ = ["ResponseTable", "cached_response_table", "response_table"]
 
 _BLOCK = 5  # vertices per grid point in the probe program (vertices 1-3 are pure)
 
@@ -183,3 +183,22 @@ def response_table(
         radius=float(radius),
         temperature=float(temperature),
     )
+
+
+_CACHE: dict[tuple, ResponseTable] = {}
+
+
+def cached_response_table(**kwargs: object) -> ResponseTable:
+    """:func:`response_table` memoised per process on its (hashable) arguments.
+
+    The table depends only on the material model and the grid, so repeated designs in one
+    session (a sweep of targets, the test-suite) build it once.
+    """
+    try:
+        key = tuple(sorted(kwargs.items()))
+        hash(key)
+    except TypeError:
+        return response_table(**kwargs)  # type: ignore[arg-type]
+    if key not in _CACHE:
+        _CACHE[key] = response_table(**kwargs)  # type: ignore[arg-type]
+    return _CACHE[key]

@@ -1,0 +1,63 @@
+"""``rotomorph inverse``: target file in, design file out that validate/simulate/gcode accept."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rotomorph.cli import main
+from rotomorph.inverse.targets import load_target
+
+ROOT = Path(__file__).resolve().parents[2]
+TARGETS = sorted((ROOT / "examples" / "targets").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", TARGETS, ids=lambda p: p.stem)
+def test_example_targets_validate(path):
+    assert load_target(str(path)).kind in ("curve", "dome", "saddle", "height_map")
+
+
+def test_curve_target_to_a_design_the_other_commands_accept(tmp_path, capsys):
+    target = tmp_path / "helix.toml"
+    target.write_text(
+        'schema_version = 1\nkind = "curve"\n[curve]\nfamily = "helix"\n'
+        "radius_start = 2.0\nradius_end = 2.2\npitch = 1.5\nturns = 1.0\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "designs" / "helix.toml"
+    assert main(["inverse", str(target), "-o", str(out)]) == 0
+    assert "RMS error" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "designs" / "helix_inverse" / "summary.json").read_text())
+    assert summary["rms_error_rel"] < 0.02 or summary["unreachable_stretches_mm"]
+    assert (tmp_path / "designs" / "helix_inverse" / "target_vs_achieved.png").stat().st_size > 0
+    assert main(["validate", str(out)]) == 0
+    assert main(["gcode", str(out), "-o", str(tmp_path / "helix.gcode")]) == 0
+    # an existing design is not overwritten without --force
+    assert main(["inverse", str(target), "-o", str(out)]) == 2
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ('schema_version = 1\nkind = "curve"\n', "needs a [curve] table"),
+        ('schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n', "[lattice]"),
+        ('kind = "curve"\n', "schema_version"),
+        ('schema_version = 1\nkind = "blob"\n', "kind"),
+        ("schema_version = 1\nkind = = 2\n", "not valid TOML"),
+    ],
+)
+def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):
+    target = tmp_path / "bad.toml"
+    target.write_text(text, encoding="utf-8")
+    assert main(["inverse", str(target), "-o", str(tmp_path / "d.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert fragment in err and len(err.splitlines()) == 1
+
+
+def test_non_utf8_target_is_refused(tmp_path, capsys):
+    target = tmp_path / "latin.toml"
+    target.write_bytes('schema_version = 1\nkind = "curve"\nname = "caf\xe9"\n'.encode("latin-1"))
+    assert main(["inverse", str(target), "-o", str(tmp_path / "d.toml")]) == 2
+    assert "UTF-8" in capsys.readouterr().err
