@@ -22,7 +22,8 @@ def test_sweeps_example_quick(tmp_path, capsys):
         "morphology_phase.png",
         "morphology_phase_length.png",
     }
-    assert all(r["predicted"] is not None and r["physical"] for r in rows)
+    # no shape passes through itself (stability is reported as unknown where not checked)
+    assert all(r["predicted"] is not None and r["physical"] is not False for r in rows)
     fits = {(r["model"], r["x"]) for r in rows if r["calibration"]}
     assert fits == {
         ("warner_terentjev", 3.0),

@@ -5,11 +5,11 @@ recomputation); the sweep file's ``outputs`` only choose the table's columns. Fi
 are per filament: a design with one filament names them plainly (``end_to_end_ratio``), a
 design with several names the filament (``filaments[1].end_to_end_ratio``).
 
-Physicality: ``min_clearance`` is the smallest distance between non-adjacent segments of the
-final shape in filament diameters (pairs already closer as printed are ignored); contact is not
-modelled by the filament solver, so values < 1 mean the filament passes through itself.
-A run is ``physical`` when it converged (status ``ok``), ``min_clearance >= 1`` and it is not
-reported unstable; unknown (null) when no clearance is available (``closed_form``).
+Physicality is the run's own verdict (:mod:`rotomorph.io.validity`, the same one
+``rotomorph simulate`` writes): ``yes`` when every step converged, was verified stable and no
+filament passes through another (``min_clearance``, in filament diameters, >= 1 without a
+contact model); ``no`` when a check failed; ``unknown`` when a check was not made (e.g. the
+solver did not verify stability). ``closed_form`` runs compute no equilibrium: unknown.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ __all__ = [
     "filament_model",
     "is_physical",
     "lattice_metrics",
+    "physical_reason",
     "select_output",
 ]
 
@@ -78,7 +79,7 @@ METRICS: tuple[Metric, ...] = (
         "curvature of the closed-form helix (per current length)",
     ),
     Metric("min_clearance", "1", "float", "filament", "closest non-adjacent segments (diameters)"),
-    Metric("stable", "", "bool", "filament", "stability reported by the solver (null if not)"),
+    Metric("stable", "", "bool", "filament", "last step verified stable (null: not checked)"),
     Metric("energy", "N mm", "float", "filament", "elastic energy at the last step"),
     Metric("iterations", "1", "int", "filament", "Newton iterations over the ramp"),
     Metric("residual", "1", "float", "filament", "relative residual at the last step"),
@@ -156,18 +157,14 @@ def select_output(metrics: Mapping[str, Any], output: str) -> Any:
 
 
 def is_physical(metrics: Mapping[str, Any]) -> bool | None:
-    """Whether every state of a finished run is physical (module docstring); ``None`` unknown."""
-    parts = [metrics["lattice"]] if "lattice" in metrics else list(metrics.get("filaments", []))
-    verdict: bool | None = True
-    for p in parts:
-        if p.get("stable") is False:
-            return False
-        clearance = p.get("min_clearance")
-        if clearance is None:
-            verdict = None
-        elif clearance < 1.0:
-            return False
-    return verdict
+    """The run's physical-state verdict as a flag: True (yes), False (no), None (unknown)."""
+    verdict = (metrics.get("physical") or {}).get("verdict")
+    return {"yes": True, "no": False}.get(str(verdict))
+
+
+def physical_reason(metrics: Mapping[str, Any]) -> str | None:
+    """Why a run's states are (not, or not known to be) physical."""
+    return (metrics.get("physical") or {}).get("reason")
 
 
 def _number(x: Any) -> float | None:
@@ -189,29 +186,21 @@ def filament_model(name: str) -> Any:
     raise InvalidParameterError("settings.filament_model", f"unknown model {name!r}")
 
 
-def _clearance(printed: np.ndarray, final: np.ndarray, radius: float) -> float:
-    from rotomorph.lattice.heating import fused_pairs, segment_clearance
-
-    n = len(printed)
-    edges = np.stack([np.arange(n - 1), np.arange(1, n)], axis=1)
-    return segment_clearance(
-        final, edges, 2.0 * radius, ignore=fused_pairs(printed, edges, 2.0 * radius)
-    )
-
-
-def filament_metrics(sim: Any, radius: float) -> dict[str, Any]:
+def filament_metrics(sim: Any, summary: Mapping[str, Any]) -> dict[str, Any]:
     """Metrics of one :class:`~rotomorph.simulate.filament.FilamentSimulation`.
 
     Parameters
     ----------
     sim
         The filament's simulation.
-    radius
-        Filament radius R (mm), for the clearance in diameters.
+    summary
+        Its entry in the described run's ``metadata["filaments"]``
+        (:func:`rotomorph.simulate.run_data.describe_run`): clearance and verdict.
     """
     helix = sim.helix
     closed = sim.closed_form
-    stable = getattr(sim, "stable", None)
+    stable = sim.stable[-1] if len(sim.stable) else None
+    clearance = summary.get("min_clearance_diameters")
     return {
         "end_to_end_ratio": _number(sim.final_ratio),
         "morphology": sim.morphology.value,
@@ -227,11 +216,12 @@ def filament_metrics(sim: Any, radius: float) -> dict[str, Any]:
         else _number(closed.end_to_end_ratio),
         "closed_form_morphology": None if closed is None else str(closed.label),
         "closed_form_curvature": None if closed is None else _number(closed.curvature),
-        "min_clearance": _number(_clearance(sim.printed, sim.positions[-1], radius)),
+        "min_clearance": None if clearance is None else _number(clearance),
         "stable": None if stable is None else bool(stable),
         "energy": _number(sim.energy[-1]),
         "iterations": int(np.sum(sim.iterations)),
         "residual": _number(sim.residual[-1]),
+        "physical": summary.get("physical"),
     }
 
 

@@ -173,7 +173,8 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
                 fil = fil.model_copy(update={"spacing": s["spacing"]})
             field = natural_field(fil.to_program(), None, s["temperature"], model=model)
             shapes.append(closed_form_metrics(field.morphology()))
-        return {"filaments": shapes}, None
+        physical = {"verdict": "unknown", "reason": "closed form: no equilibrium was solved"}
+        return {"filaments": shapes, "physical": physical}, None
     from rotomorph.simulate.design import simulate_design
 
     # simulate_design refuses options that do not apply: a lattice takes the actuation rule,
@@ -188,16 +189,24 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
         spacing=None if lattice else s["spacing"],
         actuation=s["actuation"] if lattice else None,
     )
+    from rotomorph.simulate.run_data import describe_run
+
+    described = describe_run(sim)
+    meta = described.metadata
     if sim.kind == "lattice":
         metrics: dict[str, Any] = {"lattice": lattice_metrics(sim)}
     else:
+        summaries = list(meta.get("filaments") or [])
+        summaries += [{}] * (len(sim.filaments) - len(summaries))
         metrics = {
             "filaments": [
-                filament_metrics(f, fil.radius)
-                for f, fil in zip(sim.filaments, design.filaments, strict=True)
+                filament_metrics(f, summary)
+                for f, summary in zip(sim.filaments, summaries, strict=True)
             ]
         }
-    return metrics, sim.run_results() if spec.hdf5 else None
+    verdict = meta.get("physical") or {}
+    metrics["physical"] = {"verdict": verdict.get("verdict"), "reason": verdict.get("reason")}
+    return metrics, described if spec.hdf5 else None
 
 
 class _Collect(logging.Handler):

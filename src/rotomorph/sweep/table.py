@@ -13,9 +13,10 @@ one column per output
     run did not succeed or the metric does not apply (e.g. ``helix_pitch`` of a straight rod).
 ``status`` (string)
     ``ok``, ``invalid`` or ``failed``.
-``physical`` (bool, nullable)
-    The run converged, its filaments do not pass through each other and it is not reported
-    unstable; null when unknown (module :mod:`rotomorph.sweep.metrics`).
+``physical`` (bool, nullable), ``physical_reason`` (string)
+    The run's physical-state verdict (converged, verified stable, no filament passing through
+    another): true, false, or null when a check was not made; and why
+    (:mod:`rotomorph.sweep.metrics`). False for runs that did not succeed.
 ``wall_time_s`` (float64)
     Seconds the run took on its worker (the only column that differs between two executions
     of the same sweep).
@@ -37,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from rotomorph.io.atomic import atomic_path
-from rotomorph.sweep.metrics import METRICS, is_physical, select_output
+from rotomorph.sweep.metrics import METRICS, is_physical, physical_reason, select_output
 from rotomorph.sweep.spec import Sweep
 
 __all__ = ["PARAMETER_UNITS", "TABLE_FILE", "build_table", "read_table", "write_table"]
@@ -139,6 +140,14 @@ def build_table(
         "physical",
         [is_physical(rec["metrics"]) if rec["status"] == "ok" else False for _, _, rec in rows],
         pa.bool_(),
+    )
+    add(
+        "physical_reason",
+        [
+            physical_reason(rec["metrics"]) if rec["status"] == "ok" else "no state computed"
+            for _, _, rec in rows
+        ],
+        pa.string(),
     )
     add("wall_time_s", [float(rec["wall_time_s"]) for _, _, rec in rows], pa.float64(), "s")
     errors = [rec.get("error") or {} for _, _, rec in rows]
