@@ -100,12 +100,25 @@ class FilamentSection:
         """Natural axial strain ε_c ``(n,)``, curvature ``(n, 2)`` (1/mm, toward m1, m2) and twist
         increment Δτ ``(n,)`` (1/mm) for the given print/strain state (see :meth:`eigenfields`).
         """
-        eps_zz, gamma = self.eigenfields(omega_star, eps_parallel, eps_perpendicular, eps_passive)
+        # filaments repeat a few print states along thousands of edges: evaluate each once
+        cols = np.broadcast_arrays(
+            *(np.atleast_1d(np.asarray(a, dtype=float)) for a in
+              (omega_star, eps_parallel, eps_perpendicular, eps_passive))
+        )  # fmt: skip
+        states, inverse = np.unique(np.column_stack(cols), axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        eps_zz, gamma = self.eigenfields(*states.T)
         return (
-            self.axial.natural_strain(eps_zz),
-            self.axial.natural_curvature(eps_zz),
-            self.torsion.natural_twist(gamma),
+            self.axial.natural_strain(eps_zz)[inverse],
+            self.axial.natural_curvature(eps_zz)[inverse],
+            self.torsion.natural_twist(gamma)[inverse],
         )
+
+
+@lru_cache(maxsize=16)
+def _mesh(radius: float, active_fraction: float, resolution: int) -> SectionMesh:
+    """The disk mesh, shared by every modulus pair (it depends on the geometry only)."""
+    return disk_mesh(radius, active_fraction, resolution)
 
 
 @lru_cache(maxsize=64)
@@ -118,7 +131,7 @@ def _cached(
     active_fraction: float,
     resolution: int,
 ) -> FilamentSection:
-    mesh = disk_mesh(radius, active_fraction, resolution)
+    mesh = _mesh(radius, active_fraction, resolution)
     axial = axial_section(mesh, phase_constant(e_active, e_passive))
     torsion = torsion_section(mesh, phase_constant(g_active, g_passive))
     return FilamentSection(radius, mesh, axial, torsion)

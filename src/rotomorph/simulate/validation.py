@@ -24,8 +24,11 @@ Each predicted number carries
 * ``predicted_sd``: the calibration's uncertainty propagated to it
   (:meth:`rotomorph.materials.inference.Fit.propagate`),
 * ``resolution``: the number at two resolutions (section-mesh boundary vertices 96 / 192 for
-  closed forms, node spacing h / h/2 for filaments) and ``discretisation_error`` = their
-  difference; ``converged`` is true when it is at most :data:`CONVERGENCE_RTOL` of the value.
+  closed forms, reported at 96; node spacing h / h/2 for filaments, reported at h/2) and
+  ``discretisation_error``, Richardson's estimate from the two
+  (:func:`rotomorph.simulate.convergence.at_two_resolutions`; order 2 for the section mesh,
+  1 for filaments); ``converged`` is true when it is at most :data:`CONVERGENCE_RTOL` of the
+  value.
 
 ``z`` = (predicted − measured)/√(spread² + predicted_sd²) (combined spread).
 """
@@ -33,6 +36,7 @@ Each predicted number carries
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -52,6 +56,7 @@ from rotomorph.materials.measurements import load_table
 from rotomorph.materials.natural import FilamentModel, natural_field
 from rotomorph.materials.process import order_parameter
 from rotomorph.rod.model import Model
+from rotomorph.simulate.convergence import at_two_resolutions
 from rotomorph.simulate.free_shape import free_equilibrium, min_clearance
 
 __all__ = [
@@ -119,10 +124,17 @@ def end_to_end(points: FloatArray, printed: FloatArray) -> float:
     return float(np.linalg.norm(points[-1] - points[0]) / np.linalg.norm(printed[-1] - printed[0]))
 
 
+@lru_cache(maxsize=32)
+def sinusoid_shape(side: str, model: FilamentModel, spacing: float) -> FloatArray:
+    """Zero-energy free shape ``(N, 3)`` (mm) of the heated sinusoid design (cached)."""
+    shape = free_shape(_program(side, spacing), model)
+    shape.setflags(write=False)
+    return shape
+
+
 def sinusoid_ratio(side: str, model: FilamentModel, spacing: float) -> float:
     """End-to-end ratio of the heated sinusoid design (zero-energy free shape)."""
-    prog = _program(side, spacing)
-    return end_to_end(free_shape(prog, model), prog.points)
+    return end_to_end(sinusoid_shape(side, model, spacing), _program(side, spacing).points)
 
 
 def at_resolution(model: FilamentModel, resolution: int = SECTION_RESOLUTIONS[0]) -> FilamentModel:
@@ -169,21 +181,28 @@ def row(
     predicted_sd: float | None = None,
     calibration: bool = False,
     counted: bool | None = None,
-    fine: float | None = None,
+    other: float | None = None,
+    disc_error: float | None = None,
     resolution: Sequence[float] | None = None,
     resolution_unit: str = "",
     calibrated_without: str | None = None,
     **extra: Any,
 ) -> dict[str, Any]:
-    """One summary row (module docstring); ``fine`` is the value at the finer resolution."""
+    """One summary row (module docstring).
+
+    ``other`` is the same number at the other resolution and ``disc_error`` the estimated
+    discretisation error of ``predicted`` (default ``|predicted − other|``).
+    """
     err = None if measured is None or predicted is None else predicted - measured
-    disc = None if fine is None or predicted is None else abs(fine - predicted)
+    disc = disc_error
+    if disc is None and other is not None and predicted is not None:
+        disc = abs(other - predicted)
     if predicted is None:
         converged = False
     elif disc is None:
-        converged = True  # exact (no discretisation), e.g. an input or a sign
+        converged = True  # exact (no discretisation), e.g. an input
     else:
-        converged = disc <= CONVERGENCE_RTOL * max(abs(fine), 1e-12)  # type: ignore[arg-type]
+        converged = math.isfinite(disc) and disc <= CONVERGENCE_RTOL * max(abs(predicted), 1e-12)
     z = None
     if err is not None and spread is not None and not calibration:
         comb = math.hypot(spread, predicted_sd or 0.0)
@@ -207,7 +226,7 @@ def row(
         "discretisation_error": _num(disc, 6),
         "resolution": None
         if resolution is None
-        else {"unit": resolution_unit, "values": list(resolution), "fine": _num(fine)},
+        else {"unit": resolution_unit, "values": list(resolution), "other": _num(other)},
         "calibrated_without": calibrated_without,
         "unit": unit,
         "figure": figure,
@@ -242,7 +261,9 @@ def _closed_form_rows(group: str, fit: Fit, full: Fit) -> list[dict[str, Any]]:
             float(table.spread[i]),
             float(value[i]),
             predicted_sd=float(sd[i]),
-            fine=float(fine[i]),
+            other=float(fine[i]),
+            # P1 section mesh: O(h^2); Richardson error of the coarser value r^p/(r^p - 1) |d|
+            disc_error=4.0 / 3.0 * abs(float(fine[i]) - float(value[i])),
             resolution=SECTION_RESOLUTIONS,
             resolution_unit="section boundary vertices",
             calibrated_without=group,
@@ -314,16 +335,16 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
     lo, hi = FILAMENT_SPACINGS
     rows = []
     d = SINUSOID_DESIGN
+    model = at_resolution(full.model)
     for i, side in enumerate(("outer", "inner")):
 
         def ratio(m: FilamentModel, s: str = side) -> FloatArray:
             return np.array([sinusoid_ratio(s, at_resolution(m), lo)])
 
-        value, sd = full.propagate(ratio)
-        model = at_resolution(full.model)
-        fine = sinusoid_ratio(side, model, hi)
+        _, sd = full.propagate(ratio)
+        res = at_two_resolutions(functools.partial(sinusoid_ratio, side, model), lo)
         prog = _program(side, hi)
-        clearance = min_clearance(free_shape(prog, model))
+        clearance = min_clearance(sinusoid_shape(side, model, hi))
         touching = clearance < 2.0 * float(prog.radius)
         rows.append(
             row(
@@ -331,9 +352,10 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
                 table.condition[i],
                 float(table.value[i]),
                 float(table.spread[i]),
-                float(value[0]),
+                res.value,
                 predicted_sd=float(sd[0]),
-                fine=fine,
+                other=res.coarse,
+                disc_error=res.error,
                 resolution=FILAMENT_SPACINGS,
                 resolution_unit="node spacing (mm)",
                 calibrated_without="sinusoid_end_to_end (never fitted)",
@@ -355,8 +377,14 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
     return rows
 
 
-def validate_filaments() -> Validation:
+def validate_filaments(*, cache: bool = True) -> Validation:
     """Leave-one-group-out predictions of every filament measurement (see module docstring).
+
+    Parameters
+    ----------
+    cache
+        Reuse a result stored on disk for the same package sources and data
+        (:mod:`rotomorph.simulate.cache`); the computation is deterministic.
 
     Returns
     -------
@@ -364,6 +392,14 @@ def validate_filaments() -> Validation:
         Rows for the calibration groups, the inputs and the sinusoids; the lattice rows are
         added by the report (:mod:`rotomorph.simulate.report`).
     """
+    if cache:
+        from rotomorph.simulate.cache import disk_cached
+
+        return disk_cached("validate_filaments", "v1", _validate_filaments)
+    return _validate_filaments()
+
+
+def _validate_filaments() -> Validation:
     calibrations = {"all": paper_calibration()}
     for g in CALIBRATION_GROUPS:
         calibrations[f"without {g}"] = paper_calibration(exclude=(g,))
