@@ -130,13 +130,15 @@ def free_equilibrium(model: object) -> FloatArray:
     )
 
 
-def min_clearance(points: FloatArray, *, skip: int = 3) -> float:
-    """Smallest distance (mm) between non-neighbouring vertices (``skip`` or more apart).
+def min_clearance(points: FloatArray, *, exclude_arc: float) -> float:
+    """Smallest distance (mm) between two vertices more than ``exclude_arc`` apart along the
+    curve (neighbours along the filament are always close and do not count).
 
     A value below the filament diameter means the free shape passes through itself (no contact
-    model); the caller flags it.
+    model); the caller flags it. Use ``exclude_arc`` ≳ 2 diameters.
     """
     x = np.asarray(points, dtype=float)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))])
     d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=-1)
-    i, j = np.triu_indices(len(x), k=skip)
-    return float(d[i, j].min()) if len(i) else float("inf")
+    far = np.abs(s[:, None] - s[None, :]) > exclude_arc
+    return float(d[far].min()) if np.any(far) else float("inf")

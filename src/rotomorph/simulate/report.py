@@ -236,6 +236,8 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 
 #: Ghost nodes per lattice edge at the two resolutions (quick, full).
 LATTICE_GHOSTS = {True: (6, 12), False: (10, 20)}
+#: Heating steps of the full lattice ramps.
+LATTICE_STEPS = 8
 
 
 def _heat(
@@ -264,8 +266,14 @@ def _heat(
 
 
 def _lattice_section(
-    model: FilamentModel, figs: Path, *, quick: bool, steps: int, tick: Callable[[], None]
+    model: FilamentModel,
+    figs: Path | None,
+    *,
+    quick: bool,
+    steps: int,
+    tick: Callable[[], None],
 ) -> tuple[list[dict], list[Path]]:
+    """Lattice rows and, unless ``figs`` is None, their figures."""
     from rotomorph.analysis.curvature import network_relative_curvature_change
     from rotomorph.plot.figure import new_figure, save_figure
     from rotomorph.plot.shapes import plot_lattice_views
@@ -340,12 +348,13 @@ def _lattice_section(
     ax.set_title("Fig. 3G: lattice area on heating")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    paths.append(save_figure(fig, figs / "fig3g_lattice_area.png"))
+    if figs is not None:
+        paths.append(save_figure(fig, figs / "fig3g_lattice_area.png"))
     # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i, at the last contact-free step
     # (what the elastic model can claim) and, where later, at the end of the ramp
     for pattern in ("expanding", "contracting", "dome", "saddle"):
         lattice, res, _ = results[pattern]
-        if res is None:
+        if res is None or figs is None:
             continue
         k_free, k_end = res.last_contact_free(), len(res.parameter) - 1
         for k, suffix in ((k_free, ""), (k_end, "_final")):
@@ -410,8 +419,44 @@ def _lattice_section(
         ax.set_title(f"Fig. {panel}: {pattern} (κ_g {'>' if sign > 0 else '<'} 0)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    paths.append(save_figure(fig, figs / "fig4cf_characteristic_curvature.png"))
+    if figs is not None:
+        paths.append(save_figure(fig, figs / "fig4cf_characteristic_curvature.png"))
     return rows, paths
+
+
+def paper_rows(*, quick: bool = False) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """The report's rows and score without writing anything (no figures).
+
+    Parameters
+    ----------
+    quick
+        3 × 3 lattices with 3 heating steps (the filament rows do not change).
+
+    Returns
+    -------
+    rows, summary
+        Exactly the rows of ``summary.json`` and :func:`summarise` of them.
+    """
+    val = validate_filaments()
+    lattice, _ = _lattice_section(
+        val.model, None, quick=quick, steps=3 if quick else LATTICE_STEPS, tick=lambda: None
+    )
+    rows = _ordered(val, lattice)
+    return rows, summarise(rows)
+
+
+def _ordered(val: Validation, lattice: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Rows in report order: filament groups, sinusoids, lattices, inputs."""
+    order = (
+        "janus_curvature",
+        "pure_lce_length_L_over_L0",
+        "composite_length_L_over_L0",
+        "sinusoid_end_to_end_ratio",
+    )
+    rows = [r for q in order for r in val.rows if r["quantity"] == q]
+    rows += lattice
+    rows += [r for r in val.rows if r["quantity"] in ("order_parameter", "normalized_length")]
+    return rows
 
 
 # ----------------------------------------------------------------------------- report
@@ -616,7 +661,7 @@ def paper_report(
     out = Path(folder)
     figs = out / "figures"
     figs.mkdir(parents=True, exist_ok=True)
-    lattice_steps = 3 if quick else 8
+    lattice_steps = 3 if quick else LATTICE_STEPS
     total = 4 + 4
 
     def tick() -> None:
@@ -645,7 +690,7 @@ def paper_report(
         timings[name] = time.perf_counter() - t
         if name != "lattices (Fig. 3G, 4)":
             tick()
-    rows += [r for r in val.rows if r["quantity"] in ("order_parameter", "normalized_length")]
+    rows = _ordered(val, [r for r in rows if r["quantity"].startswith("lattice")])
     summary = summarise(rows)
     wall = time.perf_counter() - t0
     timings["total"] = wall

@@ -344,7 +344,9 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
         _, sd = full.propagate(ratio)
         res = at_two_resolutions(functools.partial(sinusoid_ratio, side, model), lo)
         prog = _program(side, hi)
-        clearance = min_clearance(sinusoid_shape(side, model, hi))
+        clearance = min_clearance(
+            sinusoid_shape(side, model, hi), exclude_arc=4.0 * float(prog.radius)
+        )
         touching = clearance < 2.0 * float(prog.radius)
         rows.append(
             row(
