@@ -45,6 +45,7 @@ def test_thread_pool_and_per_run_hdf5(tmp_path):
     for r in rows:
         run = read_results(store.results_path(r["run_id"]))
         assert run.metadata["run_id"] == r["run_id"]
+        assert run.programs and "arc_length" in run.static  # the self-describing run data
         first, last = run.positions[0], run.positions[-1]
         ratio = np.linalg.norm(last[-1] - last[0]) / np.linalg.norm(first[-1] - first[0])
         assert abs(ratio - r["end_to_end_ratio"]) < 1e-12
@@ -89,3 +90,26 @@ def test_closed_form_matches_the_materials_layer(tmp_path):
         "heatmap_helix_pitch.png",
     }
     assert all(p.stat().st_size > 5000 for p in figures)
+
+
+def test_lattice_sweep_reports_the_runs_verdict(tmp_path):
+    lattice = {"n": 3, "spacing": 5.0, "amplitude": 1.25, "pattern": "dome", "layers": 1}
+    sweep = parse_sweep(
+        {
+            "schema_version": 1,
+            "design": {"schema_version": 1, "lattice": lattice},
+            "outputs": ["area_ratio", "gaussian_sign", "min_clearance", "stable"],
+            "settings": {"steps": 2},
+            "parameters": [{"path": "lattice.pattern", "values": ["dome", "saddle"]}],
+        }
+    )
+    with ThreadPoolExecutor(1) as pool:
+        rows = run_sweep(sweep, tmp_path / "lat", executor=pool).table.to_pylist()
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    for r in rows:
+        assert isinstance(r["gaussian_sign"], int) and r["area_ratio"] > 0
+        # overlapping filaments (no contact model) are never reported as physical
+        if r["min_clearance"] < 1.0:
+            assert r["physical"] is False and "pass through" in r["physical_reason"]
+        else:
+            assert r["physical"] is not False

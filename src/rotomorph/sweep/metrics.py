@@ -88,6 +88,7 @@ METRICS: tuple[Metric, ...] = (
     Metric("characteristic_curvature", "1/mm", "float", "lattice", "√|k1 k2| of the surface fit"),
     Metric("edge_strain", "1", "float", "lattice", "mean end-to-end strain of the edges"),
     Metric("min_clearance", "1", "float", "lattice", "closest non-adjacent segments (diameters)"),
+    Metric("stable", "", "bool", "lattice", "last step verified stable (null: not checked)"),
     Metric("energy", "N mm", "float", "lattice", "elastic energy at the last step"),
     Metric("iterations", "1", "int", "lattice", "Newton iterations over the ramp"),
     Metric("residual", "1", "float", "lattice", "relative residual at the last step"),
@@ -186,6 +187,12 @@ def filament_model(name: str) -> Any:
     raise InvalidParameterError("settings.filament_model", f"unknown model {name!r}")
 
 
+def _last_flag(flags: Any) -> bool | None:
+    """The last step's stability verdict (``None``: not checked or not reported)."""
+    flags = tuple(flags or ())
+    return None if not flags or flags[-1] is None else bool(flags[-1])
+
+
 def filament_metrics(sim: Any, summary: Mapping[str, Any]) -> dict[str, Any]:
     """Metrics of one :class:`~rotomorph.simulate.filament.FilamentSimulation`.
 
@@ -199,7 +206,7 @@ def filament_metrics(sim: Any, summary: Mapping[str, Any]) -> dict[str, Any]:
     """
     helix = sim.helix
     closed = sim.closed_form
-    stable = sim.stable[-1] if len(sim.stable) else None
+    stable = _last_flag(sim.stable)
     clearance = summary.get("min_clearance_diameters")
     return {
         "end_to_end_ratio": _number(sim.final_ratio),
@@ -217,7 +224,7 @@ def filament_metrics(sim: Any, summary: Mapping[str, Any]) -> dict[str, Any]:
         "closed_form_morphology": None if closed is None else str(closed.label),
         "closed_form_curvature": None if closed is None else _number(closed.curvature),
         "min_clearance": None if clearance is None else _number(clearance),
-        "stable": None if stable is None else bool(stable),
+        "stable": stable,
         "energy": _number(sim.energy[-1]),
         "iterations": int(np.sum(sim.iterations)),
         "residual": _number(sim.residual[-1]),
@@ -249,7 +256,7 @@ def lattice_metrics(sim: Any) -> dict[str, Any]:
         "characteristic_curvature": _number(sc["characteristic_curvature"][-1]),
         "edge_strain": _number(sc["edge_strain"][-1]),
         "min_clearance": _number(sc["min_clearance"][-1]),
-        "stable": None,
+        "stable": _last_flag(getattr(sim.lattice, "stable", ())),
         "energy": _number(sc["energy"][-1]),
         "iterations": int(np.sum(sc["iterations"])),
         "residual": _number(sc["residual"][-1]),

@@ -126,6 +126,8 @@ class RunStore:
                 fields=results.fields,
                 units=results.units,
                 metadata={**results.metadata, "run_id": run_id},
+                static=results.static,
+                programs=results.programs,
             )
         text = json.dumps(record, sort_keys=True, allow_nan=False)
         return atomic_write_text(path, text + "\n", fsync=self.fsync)
