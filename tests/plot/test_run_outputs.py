@@ -144,14 +144,21 @@ def test_vtk_files_open_in_meshio_with_units_in_names(run_file, tmp_path):
     np.testing.assert_allclose(mesh.cell_data["active_normal"][0], res.fields["active_normal"][2])
     np.testing.assert_allclose(mesh.cell_data["radius [mm]"][0], 0.3)
     assert "curvature [1/mm]" in mesh.point_data and "arc_length [mm]" in mesh.point_data
+    # the .vtp polylines carry per-segment arrays as point data (mean of a node's segments)
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(tmp_path / "paraview" / "morphing_0002.vtp").getroot()
+    names = {a.get("Name") for a in root.iter("DataArray")}
+    assert {"active_normal", "radius [mm]", "arc_length [mm]", "curvature [1/mm]"} <= names
 
 
 def test_cli_plot_and_view(run_file, tmp_path, capsys):
     run = run_file.parent
     figs = run / "figures"
-    assert main(["plot", str(run_file), "-o", str(figs), "--no-movie"]) == EXIT_OK
-    assert main(["plot", str(run), "-o", str(figs), "--no-movie"]) == EXIT_OK  # again, same place
-    assert not (figs / "figures").exists()
+    figs.mkdir(exist_ok=True)
+    (figs / "notes.txt").write_text("mine")  # plot replaces its own files, nothing else
+    assert main(["plot", str(run), "-o", str(figs), "--no-movie"]) == EXIT_OK
+    assert not (figs / "figures").exists() and (figs / "notes.txt").read_text() == "mine"
     pytest.importorskip("plotly")
     assert main(["view", str(run), "--no-open"]) == EXIT_OK
     html = (run / "view.html").read_text()
@@ -179,3 +186,18 @@ def test_viewer_figure_has_a_frame_per_step_and_both_sides(run_file):
     )
     assert area.min() > 1e-6  # no degenerate triangles
     assert "NOT PHYSICAL" in fig.frames[-1].layout.title.text
+
+
+def test_movie_falls_back_to_a_gif_without_ffmpeg(tmp_path, monkeypatch):
+    import rotomorph.plot.animate as animate
+
+    monkeypatch.setattr(animate, "ffmpeg_available", lambda: False)
+    frames = [np.full((40, 60, 3), v, dtype=np.uint8) for v in (0, 120, 240)]
+    path = animate.write_movie(frames, 3, tmp_path / "m.mp4", seconds_per_frame=0.5)
+    assert path.suffix == ".gif"
+    with Image.open(path) as im:
+        durations = []
+        for k in range(im.n_frames):
+            im.seek(k)
+            durations.append(im.info["duration"])
+    assert sum(durations) >= 5000  # ms: held frames make at least 5 s

@@ -416,8 +416,10 @@ def plot_tube_panels(
             fontsize=8,
             zorder=3,
         )
-        if p.title:  # inside the panel: never over the figure title or a neighbour
-            ax.text2D(0.5, 0.99, p.title, transform=ax.transAxes, ha="center", va="top", fontsize=9)
+        if p.title:  # inside the panel, wrapped to its width: never over a neighbour
+            chars = max(12, int(panel_size * 72 / (9 * 0.55)))
+            text = "\n".join(textwrap.fill(line, chars) for line in p.title.split("\n"))
+            ax.text2D(0.5, 0.99, text, transform=ax.transAxes, ha="center", va="top", fontsize=9)
     if has_values and norm is not None and colormap is not None:
         from matplotlib.cm import ScalarMappable
 

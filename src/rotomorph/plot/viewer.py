@@ -20,6 +20,7 @@ from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import RunResults
 from rotomorph.io.validity import assess, run_verdict
+from rotomorph.plot.shapes import scalar_norm
 from rotomorph.plot.tubes import ACTIVE_COLOUR, PASSIVE_COLOUR, tube_mesh
 
 __all__ = ["viewer_fields", "viewer_figure", "write_viewer"]
@@ -124,12 +125,9 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     labels = _labels(results)
     values = None if field == "janus" else _segment_field(results, field)
     if values is not None:
-        finite = values[np.isfinite(values)]
-        lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (-1.0, 1.0)
-        if lo < 0 < hi:
-            lo, hi = -max(-lo, hi), max(-lo, hi)
-        if hi - lo < 1e-9 * max(1.0, abs(hi)):
-            lo, hi = lo - 1.0, hi + 1.0
+        # the figures' limits: robust, symmetric for signed data, round-off drawn as neutral
+        norm = scalar_norm(values.reshape(-1))
+        lo, hi = float(norm.vmin or 0.0), float(norm.vmax or 1.0)
         cscale: Any = "RdBu_r"
         unit = results.units.get(field, "")
         cbar = {"title": f"{field} ({unit})" if unit not in ("", "1") else field}

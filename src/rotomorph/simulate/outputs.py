@@ -411,6 +411,18 @@ def write_vtk(results: RunResults, folder: str | os.PathLike[str]) -> list[Path]
             point[name] = np.broadcast_to(v, (s, *v.shape))
         if len(v) == e and name not in cell:
             cell[name] = np.broadcast_to(v, (s, *v.shape))
+    # lattice measures per lattice edge onto its segments (cell data)
+    lattice_edge = results.static.get("lattice_edge")
+    if lattice_edge is not None and len(lattice_edge) == e and lattice_edge.max() >= 0:
+        count, on = int(lattice_edge.max()) + 1, lattice_edge >= 0
+        for name, v in results.fields.items():
+            if v.ndim == 2 and v.shape[1] == count and count not in (n, e):
+                cell[name] = np.where(on[None, :], v[:, np.maximum(lattice_edge, 0)], np.nan)
+    # per-segment arrays also as point data (mean of the incident segments; directions
+    # normalised) so the .vtp polylines, which carry point data only, hold them too
+    for name, v in list(cell.items()):
+        if name not in point and np.asarray(v).dtype.kind == "f":
+            point[name] = _segments_to_nodes(np.asarray(v, dtype=float), results.edges, n)
 
     def named(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         # VTK arrays carry no unit attribute: dimensional ones name it, e.g. "twist [1/mm]"
@@ -440,6 +452,24 @@ def write_vtk(results: RunResults, folder: str | os.PathLike[str]) -> list[Path]
             cell_data=cell,
         ),
     ]
+
+
+def _segments_to_nodes(values: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
+    """Mean over each node's segments of per-segment ``(S, E, ...)`` values → ``(S, N, ...)``;
+    3-vectors are renormalised (unit directions stay unit where they do not cancel)."""
+    out = np.zeros((values.shape[0], n, *values.shape[2:]))
+    count = np.zeros(n)
+    clean = np.nan_to_num(values)
+    for end in (0, 1):
+        for k in range(values.shape[0]):
+            np.add.at(out[k], edges[:, end], clean[k])
+        np.add.at(count, edges[:, end], 1.0)
+    shape = (1, n) + (1,) * (values.ndim - 2)
+    out /= np.maximum(count, 1.0).reshape(shape)
+    if values.ndim == 3 and values.shape[2] == 3:
+        norm = np.linalg.norm(out, axis=2, keepdims=True)
+        out = np.where(norm > 1e-9, out / np.where(norm > 0, norm, 1.0), 0.0)
+    return out
 
 
 def run_line(results: RunResults) -> str:
