@@ -68,6 +68,75 @@ def _progress(total: int, desc: str) -> Any:
     return tqdm(total=total, desc=desc, unit="step", disable=not sys.stderr.isatty(), leave=False)
 
 
+def _show_progress() -> bool:
+    """Progress (bars, phases, the compile note) goes to a terminal or with --verbose."""
+    return sys.stderr.isatty() or logging.getLogger("rotomorph").isEnabledFor(logging.INFO)
+
+
+@contextlib.contextmanager
+def _phases() -> Iterator[None]:
+    """Show the library's phase messages (``rotomorph.progress``) while a command runs."""
+    log = logging.getLogger("rotomorph.progress")
+    if not _show_progress():
+        yield
+        return
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("rotomorph: %(message)s"))
+    old = (log.level, log.propagate)
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    log.propagate = False
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(old[0])
+        log.propagate = old[1]
+
+
+@contextlib.contextmanager
+def _compiling_note() -> Iterator[None]:
+    """Say "compiling kernels (first run only)" at once when the kernel cache is cold, with a
+    bar of compiled kernels (a watcher thread) until they are all loaded or the command ends."""
+    if not _show_progress():
+        yield
+        return
+    import threading
+    import time
+
+    from rotomorph.simulate.kernel_cache import compiled_count, dispatchers, kernels_cached
+
+    if kernels_cached():
+        yield
+        return
+    sys.stderr.write(
+        "rotomorph: compiling kernels (first run only; about 1 min on 2 cores, cached after)\n"
+    )
+    done = threading.Event()
+    t0 = time.perf_counter()
+
+    def watch() -> None:
+        from tqdm import tqdm
+
+        total = len(dispatchers())
+        with tqdm(total=total, desc="compiling kernels", unit="kernel", leave=False) as bar:
+            while not done.wait(0.5) and kernels_cached() is False:
+                bar.update(compiled_count() - bar.n)
+
+    thread = threading.Thread(target=watch, daemon=True)
+    if sys.stderr.isatty():  # a live bar only on a terminal (no \r in logs)
+        thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        if thread.is_alive():
+            thread.join(timeout=2)
+        logging.getLogger("rotomorph.progress").info(
+            "kernels ready after %.0f s", time.perf_counter() - t0
+        )
+
+
 def _existing_file(path: str, what: str) -> Path:
     if not path:
         raise UsageError(f"{what}: empty path; give a file name")
@@ -220,7 +289,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     except InvalidParameterError as err:
         flag = "--" + err.field.replace("_", "-")
         raise UsageError(f"{flag}: {str(err).split(': ', 1)[1]}") from None
-    with _output_folder(args.output, force=args.force) as tmp:
+    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note():
         with _progress(step_count(design, args.steps), "simulate") as bar:
             sim = simulate_design(
                 design,
@@ -231,6 +300,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                 actuation=args.actuation,
                 progress=bar.update,
             )
+        logging.getLogger("rotomorph.progress").info("writing results, figures and movie")
         results = describe_run(sim)
         write_run_results(results, tmp, movie=not args.no_movie)
     _print(f"wrote {args.output}: {run_line(results)}")
@@ -287,7 +357,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 def _cmd_paper(args: argparse.Namespace) -> int:
     from rotomorph.simulate.report import paper_report
 
-    with _output_folder(args.output, force=args.force) as tmp:
+    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note():
         with _progress(0, "paper") as bar:
 
             def progress(done: int, total: int) -> None:

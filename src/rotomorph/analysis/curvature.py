@@ -178,20 +178,43 @@ def network_relative_curvature_change(
             "reference", f"must have the shape of positions {pos.shape}; got {ref.shape}"
         )
     chains = [as_index(c, f"edge_chains[{k}]", len(pos)) for k, c in enumerate(edge_chains)]
+    # chains of equal length are stacked and done at once (a lattice: all of them), so the cost
+    # is a few array operations, not a Python loop over 20 000 edges
+    groups: dict[int, list[IntArray]] = {}
+    for c in chains:
+        groups.setdefault(len(c), []).append(c)
+    stacked = {n: np.stack(cs) for n, cs in groups.items() if n >= 3}
+    kappa_ref = {n: _stacked_curvature(ref[idx]) for n, idx in stacked.items()}
     if floor is None:
-        kmax = max((float(discrete_curvature(ref[c]).max(initial=0.0)) for c in chains), default=0)
+        kmax = max((float(k.max(initial=0.0)) for k in kappa_ref.values()), default=0.0)
         floor = 1e-9 * kmax
     total = np.zeros(len(pos))
     count = np.zeros(len(pos))
-    for c in chains:
-        values = relative_curvature_change(pos[c], ref[c], floor=floor)
-        ok = np.isfinite(values)
-        np.add.at(total, c[ok], values[ok])
-        np.add.at(count, c[ok], 1.0)
+    for n, idx in stacked.items():
+        kappa, kappa_i = _stacked_curvature(pos[idx]), kappa_ref[n]
+        ok = kappa_i > floor
+        values = np.where(ok, (kappa - kappa_i) / np.where(ok, kappa_i, 1.0), 0.0)
+        inner = idx[:, 1:-1]
+        total += np.bincount(inner[ok], weights=values[ok], minlength=len(pos))
+        count += np.bincount(inner[ok], minlength=len(pos))
     out = np.full(len(pos), np.nan)
     has = count > 0
     out[has] = total[has] / count[has]
     return out
+
+
+def _stacked_curvature(points: FloatArray) -> FloatArray:
+    """:func:`discrete_curvature` of ``(C, L, 3)`` stacked polylines, ``(C, L-2)`` (1/mm)."""
+    e = np.diff(points, axis=1)
+    lengths = np.linalg.norm(e, axis=2)
+    if np.any(lengths == 0.0):
+        c, i = np.argwhere(lengths == 0.0)[0]
+        raise InvalidParameterError(
+            "points", f"edge {int(i)} of chain {int(c)} has zero length; remove repeated points"
+        )
+    c, n = e.shape[0], e.shape[1] - 1
+    kb = curvature_binormal(e[:, :-1].reshape(-1, 3), e[:, 1:].reshape(-1, 3)).reshape(c, n, 3)
+    return np.linalg.norm(kb, axis=2) / (0.5 * (lengths[:, :-1] + lengths[:, 1:]))
 
 
 # ----------------------------------------------------------------------------- surfaces

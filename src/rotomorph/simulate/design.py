@@ -10,6 +10,7 @@ Lattices go through :func:`rotomorph.lattice.heating.heat_lattice` (imported whe
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -21,7 +22,7 @@ import rotomorph
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.analysis.curvature import network_relative_curvature_change
 from rotomorph.errors import InvalidDesignError
-from rotomorph.io.designfile import with_spacing
+from rotomorph.io.designfile import design_size, with_spacing
 from rotomorph.io.results import RunResults, to_jsonable
 from rotomorph.materials.natural import FilamentModel
 from rotomorph.simulate.filament import (
@@ -35,6 +36,8 @@ from rotomorph.simulate.options import check_run_options
 __all__ = ["DesignSimulation", "simulate_design", "step_count"]
 
 Progress = Callable[[int], None]
+#: Phase messages (set-up, solve, analysis); the CLI shows them on a terminal.
+phase_log = logging.getLogger("rotomorph.progress")
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,6 +149,13 @@ def _simulate_filaments(
 ) -> DesignSimulation:
     sims = []
     for i, fil in enumerate(design.filaments):
+        phase_log.info(
+            "filament %d/%d: %s rod nodes, %d heating step(s)",
+            i + 1,
+            len(design.filaments),
+            f"{fil.node_count():,}",
+            steps,
+        )
         program = fil.to_program()
         sims.append(
             simulate_filament(
@@ -212,10 +222,22 @@ def _simulate_lattice(
 ) -> DesignSimulation:
     from rotomorph.lattice.heating import heat_lattice  # lattice-only
 
-    lattice = design.lattice.to_lattice()
+    lat = design.lattice
+    size = design_size(design)
+    phase_log.info(
+        "set-up: %dx%d lattice, %s rod nodes (estimated ~%.1f GB, ~%.0f s)",
+        lat.n,
+        lat.n,
+        f"{size.nodes:,}",
+        size.memory_bytes / 1e9,
+        size.setup_seconds,
+    )
+    lattice = lat.to_lattice()
+    phase_log.info("set-up: rod model, sparsity pattern; then solving %d heating step(s)", steps)
     res = heat_lattice(lattice, actuation=actuation, steps=steps)
     if progress is not None:
         progress(1)
+    phase_log.info("analysis: curvature changes, areas")
     pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
     rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])
     ramp = "temperature" if actuation == "thermal" else "actuation"

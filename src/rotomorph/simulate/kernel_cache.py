@@ -1,0 +1,73 @@
+"""The compiled (numba) kernels: are they in the on-disk cache, and how many are compiled.
+
+Every kernel is compiled with ``cache=True``, so only the first run on a machine (or after an
+upgrade) compiles; later runs load machine code from ``__pycache__``. The command line uses
+:func:`kernels_cached` to say "compiling kernels (first run only)" before that happens, and
+:func:`compiled_count` to show how far the compilation has got.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+from typing import Any, Final
+
+__all__ = ["CORE_KERNELS", "KERNEL_MODULES", "compiled_count", "dispatchers", "kernels_cached"]
+
+logger = logging.getLogger(__name__)
+
+#: Modules holding compiled kernels.
+KERNEL_MODULES: Final = (
+    "rotomorph.geometry",
+    "rotomorph.rod.kernels",
+    "rotomorph.rod.assembly",
+    "rotomorph.solve.banded",
+    "rotomorph.solve.sparse_cholesky",
+    "rotomorph.solve.retraction",
+)
+
+
+def dispatchers() -> list[Any]:
+    """The top-level numba dispatchers of :data:`KERNEL_MODULES` (inlined helpers excluded)."""
+    from numba.core.registry import CPUDispatcher
+
+    out = []
+    for name in KERNEL_MODULES:
+        module = importlib.import_module(name)
+        for value in vars(module).values():
+            if (
+                isinstance(value, CPUDispatcher)
+                and value.__module__ == name
+                and value.targetoptions.get("inline", "never") == "never"
+            ):
+                out.append(value)
+    return out
+
+
+#: Kernels every solve runs (and that dominate the compile time): "cached" means these are.
+CORE_KERNELS: Final = ("bend_twist_stencil", "stretch_edge", "evaluate_network", "assemble")
+
+
+def kernels_cached() -> bool:
+    """True when the core kernels (:data:`CORE_KERNELS`) have machine code in the on-disk cache.
+
+    Reads numba's cache index (the index is invalidated when a source file changes); any
+    failure to read it counts as "not cached". Rarely used kernels are not required: they
+    compile in a second or two when first needed.
+    """
+    try:
+        for disp in dispatchers():
+            if disp.py_func.__name__ not in CORE_KERNELS:
+                continue
+            cache = getattr(disp, "_cache", None)
+            if cache is None or not cache._cache_file._load_index():
+                return False
+    except Exception as err:  # numba internals: report "unknown" as not cached
+        logger.debug("could not read the numba cache index: %s", err)
+        return False
+    return True
+
+
+def compiled_count() -> int:
+    """Kernels compiled or loaded in this process so far (of ``len(dispatchers())``)."""
+    return sum(1 for disp in dispatchers() if disp.overloads)
