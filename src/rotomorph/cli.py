@@ -442,8 +442,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--spacing", type=float, help="filament vertex spacing override (mm)")
     p.add_argument(
         "--actuation",
-        choices=("literal", "swapped", "radius", "additive", "thermal"),
-        help="lattice actuation rule (lattices; default swapped; see rotomorph.lattice.actuation)",
+        choices=("program", "thermal", "literal", "swapped", "radius", "additive"),
+        help="lattice actuation rule (lattices; default program: each line's print program "
+        "at the heating temperature; see rotomorph.lattice.actuation)",
     )
     p.add_argument("--no-movie", "--no-gif", action="store_true", help="skip the movie")
     p.add_argument("--force", action="store_true", help="replace a non-empty OUT")

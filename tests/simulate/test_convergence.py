@@ -36,10 +36,10 @@ def test_contracting_sinusoid_converges_with_node_spacing(model):
     # sharp flips of the active side between two vertices act as steps at the edge midpoint;
     # sampling the edge's mean nozzle angle put the active half on top over each flip edge
     # (out-of-plane curvature K_J h per flip) and the ratio moved 0.2 -> 0.5 with h
-    coarse = _ratio(_sinusoid("inner", 0.2), model)
-    res = at_two_resolutions(lambda h: _ratio(_sinusoid("inner", h), model), 0.1, rtol=5e-3)
+    # and the nozzle's flip rotation wound a spurious director helix over the two vertices
+    # around each flip (eigen-twist of order 0.3 rad per flip at h = 0.45 mm)
+    res = at_two_resolutions(lambda h: _ratio(_sinusoid("inner", h), model), 0.2, rtol=2e-3)
     assert res.converged, res
-    assert abs(res.value - res.coarse) < 0.5 * abs(res.coarse - coarse)
     assert 0.2 < res.value < 0.6
 
 

@@ -34,7 +34,11 @@ from rotomorph.design.path import Path
 from rotomorph.design.program import PrintProgram, active_side_angle
 from rotomorph.errors import InvalidDesignError
 
-__all__ = ["MODES", "PATTERNS", "Lattice", "sinusoidal_lattice"]
+__all__ = ["ASSUMED_FIELDS", "MODES", "PATTERNS", "Lattice", "sinusoidal_lattice"]
+
+#: Geometric inputs of the paper's lattice that the paper does not give (mm): every result that
+#: depends on them is a consequence of these assumptions, not of a measurement.
+ASSUMED_FIELDS = ("spacing", "amplitude", "radius")
 
 MODES = ("expanding", "contracting")
 PATTERNS = ("expanding", "contracting", "dome", "saddle")
@@ -131,6 +135,15 @@ class Lattice:
         Number of printed layers and their spacing in z (mm).
     speed, radius, active_fraction, active_material, passive_material
         Printing parameters of every filament (mm/s, mm, –, names).
+    flip_length
+        Arc length (mm) over which the nozzle turns the active side by π at each inflection
+        (0: a step, the ideal sharp flip; a machine with rotation limit ω_max needs at least
+        π v / ω_max).
+
+    Notes
+    -----
+    The paper does not give A, l (= the wavelength: one period per edge) or the filament
+    radius; :data:`ASSUMED_FIELDS` names them so outputs can flag them as assumptions.
     """
 
     network: Network
@@ -148,6 +161,7 @@ class Lattice:
     active_fraction: float = 0.5
     active_material: str = "lce"
     passive_material: str = "acrylate"
+    flip_length: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # ----------------------------------------------------------------- branch nodes
@@ -202,6 +216,21 @@ class Lattice:
             + np.outer(self.amplitude * np.sin(2 * np.pi * s / per), nrm)
         )
 
+    def line_programs(self) -> list[tuple[PrintProgram, IntArray]]:
+        """The printed lines of one layer at network resolution, with their segments.
+
+        Returns ``(program, segments)`` per line (x-lines by j, then y-lines by i): program
+        edge k is network segment ``segments[k]``, so program vertex k is that segment's first
+        node (the lattice's natural field comes from these programs).
+        """
+        progs = self.print_programs(1)[: len(self._lines())]
+        per = self.ghost_nodes + 1
+        out = []
+        for prog, line in zip(progs, self._lines(), strict=True):
+            segs = np.concatenate([np.arange(e * per, (e + 1) * per) for e in line])
+            out.append((prog, segs))
+        return out
+
     def print_programs(self, subdivide: int = 4) -> list[PrintProgram]:
         """One :class:`PrintProgram` per line and layer (``2 n · layers``), layer by layer.
 
@@ -235,7 +264,7 @@ class Lattice:
                     sgn = 1.0 if self.edge_mode[e] == "expanding" else -1.0
                     side.extend([sgn] * len(pts))
                 path = Path(np.concatenate(pieces))
-                alpha = active_side_angle(path, np.array(side))
+                alpha = active_side_angle(path, np.array(side), self.flip_length)
                 base.append(
                     PrintProgram.from_interface_angle(
                         path,
@@ -245,6 +274,7 @@ class Lattice:
                         active_fraction=self.active_fraction,
                         active_material=self.active_material,
                         passive_material=self.passive_material,
+                        step_flips=self.flip_length == 0,
                     )
                 )
             self._cache[key] = [
@@ -306,6 +336,7 @@ def sinusoidal_lattice(
     active_fraction: float = 0.5,
     active_material: str = "lce",
     passive_material: str = "acrylate",
+    flip_length: float = 0.0,
 ) -> Lattice:
     """The paper's n × n lattice of one-period sinusoidal edges (module docstring).
 
@@ -331,6 +362,8 @@ def sinusoidal_lattice(
         Printed layers (paper: 3) and their z spacing (mm).
     speed, radius, active_fraction, active_material, passive_material
         Printing parameters: v (mm/s), R (mm), active area fraction, material names.
+    flip_length
+        Arc length (mm, >= 0) of each π flip of the active side (0: a step).
 
     Raises
     ------
@@ -351,6 +384,8 @@ def sinusoidal_lattice(
     ):
         if not (np.isfinite(value) and value > lo):
             raise InvalidDesignError(name, f"must be > 0 (mm or mm/s); got {value}")
+    if not (np.isfinite(flip_length) and flip_length >= 0):
+        raise InvalidDesignError("flip_length", f"must be >= 0 mm; got {flip_length}")
     if not (np.isfinite(amplitude) and amplitude >= 0):
         raise InvalidDesignError("amplitude", f"must be >= 0 mm; got {amplitude}")
     n, ghost_nodes, layers = int(n), int(ghost_nodes), int(layers)
@@ -395,4 +430,5 @@ def sinusoidal_lattice(
         float(active_fraction),
         active_material,
         passive_material,
+        float(flip_length),
     )

@@ -113,6 +113,12 @@ class PrintProgram:
         Material names (default ``"lce"``, ``"acrylate"``).
     layer
         Layer index (>= 0).
+    step_flips
+        True when the program's flips of the active side (interface-angle changes of π/2 or
+        more between two vertices) stand for ideal steps (``flip_length = 0``): the natural
+        field then takes them as steps at the edge midpoint, with no director helix wound
+        by the flip itself (:attr:`director_rotation`). The G-code still turns the nozzle
+        over that one edge.
 
     Raises
     ------
@@ -128,6 +134,7 @@ class PrintProgram:
     active_material: str = "lce"
     passive_material: str = "acrylate"
     layer: int = 0
+    step_flips: bool = False
 
     def __post_init__(self) -> None:
         pts = Path(self.points).points.copy()
@@ -189,6 +196,23 @@ class PrintProgram:
         """Nozzle rotation rate ω = v dα_n/ds per vertex ``(N,)`` (rad/s)."""
         s = self.arc_length
         return self.speed * np.gradient(self.nozzle_angle, s)
+
+    @property
+    def director_rotation(self) -> FloatArray:
+        """Nozzle rotation rate that winds the director helix, per vertex ``(N,)`` (rad/s).
+
+        :attr:`rotation`, except with ``step_flips``: the ideal flips (interface-angle
+        changes of π/2 or more over one edge) have zero length, so their rotation winds no
+        helix; there the nozzle counts as only tracking the heading.
+        """
+        if not self.step_flips:
+            return self.rotation
+        psi = _vertex_heading(self.path)
+        d_noz = np.diff(self.nozzle_angle)
+        d_alpha = np.diff(psi) - d_noz
+        flip = np.abs(d_alpha) >= 0.5 * np.pi - 1e-9
+        smooth = np.concatenate([[0.0], np.cumsum(np.where(flip, np.diff(psi), d_noz))])
+        return self.speed * np.gradient(smooth, self.arc_length)
 
     def rotation_number(self) -> FloatArray:
         """Dimensionless rotation rate ω* = Rω/v = R dα_n/ds per vertex ``(N,)``."""
@@ -343,6 +367,7 @@ class PrintProgram:
             choose about ``π v / max_rotation`` to respect the machine's rotation limit.
         """
         alpha = active_side_angle(path, side, flip_length)
+        kwargs.setdefault("step_flips", flip_length == 0)
         return cls.from_interface_angle(path, speed, alpha, **kwargs)
 
 

@@ -322,6 +322,7 @@ class Filament(_Control):
         )
         if self.active_side is not None:
             alpha = active_side_angle(path, self.active_side, self.flip_length)
+            kw["step_flips"] = self.flip_length == 0  # ideal flips: steps in the natural field
             return PrintProgram.from_interface_angle(path, speed, alpha, **kw)
         h = path.heading
         psi_v = np.concatenate([[h[0]], 0.5 * (h[1:] + h[:-1]), [h[-1]]])
@@ -382,6 +383,12 @@ class LatticeModel(_Model):
     active_material: str = Field("lce", min_length=1, max_length=100)
     passive_material: str = Field("acrylate", min_length=1, max_length=100)
     origin: Vec3 = (0.0, 0.0, 0.0)
+    flip_length: float = Field(
+        0.0,
+        ge=0,
+        le=LIMITS["extent"].maximum,
+        description="arc length (mm) of each pi flip of the active side (0: a step)",
+    )
 
     @field_validator("active_material")
     @classmethod
@@ -432,6 +439,7 @@ class LatticeModel(_Model):
             active_fraction=self.active_fraction,
             active_material=self.active_material,
             passive_material=self.passive_material,
+            flip_length=self.flip_length,
         )
 
 

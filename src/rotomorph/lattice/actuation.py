@@ -13,7 +13,7 @@ name            natural curvature at ramp parameter x (expanding = active outer 
 ``literal``     (a) the paper's words: κ̄ = (1 + x) κ0 on straightening, (1 − x) κ0 on curling
                 edges. Inverts the paper (expanding lattices contract, dome patterns give
                 saddles; notes Q4 and §6) — kept as a documented known fact.
-``swapped``     (b) labels swapped, **default** (notes Q4, §6): (1 − x) κ0 expanding,
+``swapped``     (b) labels swapped (the reading that keeps the paper's signs): (1 − x) κ0 expanding,
                 (1 + x) κ0 contracting.
 ``radius``      (c) c multiplies the radius of curvature: κ0/(1 + x) expanding, κ0/(1 − x)
                 contracting (4 κ0 at x = 0.75; curling edges loop through themselves).
@@ -21,9 +21,22 @@ name            natural curvature at ramp parameter x (expanding = active outer 
                 Janus curvature from the materials layer at the lattice's print speed, or given).
 ``thermal``     temperature T (°C) → actuation fraction x(T) (materials layer); κ̄ = κ0 +
                 x(T) K_J toward the active side and rest lengths × exp(x ε_c) (centre-line
-                strain of the Janus section); printed turning angles are kept, so a pure axial
-                strain is a similarity.
+                strain of the Janus section, one K_J for the whole lattice at ω* = 0); printed
+                turning angles are kept, so a pure axial strain is a similarity.
+``program``     **default.** Temperature T (°C); every printed line of the lattice goes
+                through the same chain as a single filament
+                (:func:`rotomorph.materials.natural.actuation_increments`): its print program
+                (speed, the nozzle rotation that keeps the active side, the flips) and the
+                materials at T give per-vertex curvature vectors, eigen-twists and per-edge
+                centre-line strains, read in the lattice's frames. Pass-through pairs at branch
+                nodes are vertices of their line and actuate; cross pairs (bonds between two
+                lines) keep their printed values.
 ==============  =============================================================================
+
+The readings (a)-(d) reproduce or compare with the paper's own phenomenological simulation
+(c_s = 1 + x, c_t = 1 − x, Methods); their magnitude depends on the amplitude A and the cell
+size l, which the paper does not give. Only ``program`` and ``thermal`` predict from print
+parameters.
 """
 
 from __future__ import annotations
@@ -33,23 +46,31 @@ from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
 
+from rotomorph._typing import IntArray
 from rotomorph.errors import InvalidParameterError
-from rotomorph.lattice.model import LatticeModel
+from rotomorph.geometry import curvature_increment, unit
+from rotomorph.lattice.model import LatticeModel, Stiffness
 from rotomorph.materials.material import get_material
-from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.natural import FilamentModel, actuation_increments
 from rotomorph.materials.process import actuation_fraction
 from rotomorph.rod.model import Model
 
 __all__ = [
     "ACTUATIONS",
+    "DEFAULT_ACTUATION",
     "Actuation",
     "AdditiveCurvature",
     "CurvatureScaling",
+    "ProgramActuation",
     "ThermalActuation",
+    "default_stiffness",
     "get_actuation",
 ]
 
-ACTUATIONS = ("literal", "swapped", "radius", "additive", "thermal")
+ACTUATIONS = ("literal", "swapped", "radius", "additive", "thermal", "program")
+
+#: The actuation a lattice is heated with unless another is asked for.
+DEFAULT_ACTUATION = "program"
 
 #: Final ramp value of the paper's x (Methods: x from 0 to 0.75).
 PAPER_FINAL_X = 0.75
@@ -244,6 +265,119 @@ class ThermalActuation:
         return _additive(lm, x * k_j, stretch)
 
 
+def _line_stencils(lm: LatticeModel) -> list[tuple[int, IntArray, IntArray, IntArray, IntArray]]:
+    """Where each printed line's increments go in ``lm``'s model.
+
+    Per line that has model edges: (line index, increment rows, their stencils, line edges,
+    their model edges). Interior line vertex i (increment row i - 1) lands on the stencil
+    joining the model edges of line edges i - 1 and i, when the model has both.
+    """
+    key = ("line_stencils", id(lm.model))
+    cache = lm.lattice._cache
+    if key not in cache:
+        st = lm.model.stencils
+        segments = np.arange(lm.model.network.n_edges) if lm.segments is None else lm.segments
+        model_edge = {int(g): k for k, g in enumerate(segments)}
+        index = {
+            (int(min(a, b)), int(max(a, b))): k
+            for k, (a, b) in enumerate(zip(st.edge_e, st.edge_f, strict=True))
+        }
+        out = []
+        for line, (_, segs) in enumerate(lm.lattice.line_programs()):
+            edges = [model_edge.get(int(g)) for g in segs]
+            rows, stencils = [], []
+            for i in range(1, len(segs)):
+                a, b = edges[i - 1], edges[i]
+                k = None if a is None or b is None else index.get((min(a, b), max(a, b)))
+                if k is not None:
+                    rows.append(i - 1)
+                    stencils.append(k)
+            here = [i for i, e in enumerate(edges) if e is not None]
+            if here:
+                out.append(
+                    (
+                        line,
+                        np.array(rows, dtype=np.int64),
+                        np.array(stencils, dtype=np.int64),
+                        np.array(here, dtype=np.int64),
+                        np.array([edges[i] for i in here], dtype=np.int64),
+                    )
+                )
+        cache[key] = out
+    return cache[key]  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class ProgramActuation:
+    """Default mode: each printed line's natural field from its print program at T (°C).
+
+    Parameters
+    ----------
+    start, end
+        Temperature ramp (°C); the paper heats 25 → 150-175 °C.
+    filament_model
+        Materials modelling choices (strain model, modulus ratio, transition).
+
+    Notes
+    -----
+    The lines are those of :meth:`rotomorph.design.lattices.Lattice.line_programs` (one layer:
+    stacked layers act as one thicker filament of the same shape). Their increments are the
+    frame-free output of :func:`~rotomorph.materials.natural.actuation_increments`, read in
+    the lattice model's frames with :func:`rotomorph.geometry.curvature_increment`, exactly as
+    a single filament reads them in its own.
+    """
+
+    start: float = 25.0
+    end: float = 175.0
+    filament_model: FilamentModel | None = None
+    name: str = "program"
+
+    def __post_init__(self) -> None:
+        _check_range("ProgramActuation", self.start, self.end)
+
+    def natural(self, lm: LatticeModel, parameter: float) -> Model:
+        """Printed values plus every line's actuation increments at T = ``parameter``."""
+        fm = FilamentModel() if self.filament_model is None else self.filament_model
+        model = lm.model
+        st = model.stencils
+        vec = np.zeros((st.count, 3))
+        twist = np.zeros(st.count)
+        stretch = np.ones(model.network.n_edges)
+        programs = lm.lattice.line_programs()
+        for line, rows, stencils, line_edges, model_edges in _line_stencils(lm):
+            inc = actuation_increments(programs[line][0], temperature=float(parameter), model=fm)
+            vec[stencils] = inc.curvature[rows]
+            twist[stencils] = inc.twist[rows]
+            stretch[model_edges] = inc.stretch[line_edges]
+        x = model.network.nodes
+        te = unit(x[st.nodes[:, 1]] - x[st.nodes[:, 0]])
+        tf = unit(x[st.nodes[:, 2]] - x[st.nodes[:, 1]])
+        m1 = np.asarray(model.directors)
+        dk1, dk2 = curvature_increment(te, tf, m1[st.edge_e], m1[st.edge_f], vec)
+        k1, k2, tw = lm.printed
+        return model.with_natural(
+            curvature1=k1 + dk1,
+            curvature2=k2 + dk2,
+            twist=tw + twist,
+            rest_length=model.network.edge_lengths * stretch,
+        )
+
+
+def default_stiffness(
+    actuation: Actuation, stiffness: Stiffness | None = None
+) -> tuple[Stiffness, FilamentModel | None]:
+    """Stiffness option and materials model a lattice is built with for ``actuation``.
+
+    The physical modes (``program``, ``thermal``) use the Janus section of their own
+    :class:`FilamentModel`, so stiffness and natural field come from one materials model; the
+    paper's readings use its isotropic section. An explicit ``stiffness`` is kept.
+    """
+    fm = getattr(actuation, "filament_model", None)
+    physical = isinstance(actuation, (ProgramActuation, ThermalActuation))
+    chosen: Stiffness = stiffness or ("janus" if physical else "paper")
+    return chosen, fm if chosen == "janus" else None
+
+
 def get_actuation(actuation: str | Actuation) -> Actuation:
     """An actuation by name (module table) or the object itself.
 
@@ -259,6 +393,8 @@ def get_actuation(actuation: str | Actuation) -> Actuation:
             return AdditiveCurvature()
         if actuation == "thermal":
             return ThermalActuation()
+        if actuation == "program":
+            return ProgramActuation()
         raise InvalidParameterError(
             "actuation", f"must be one of {ACTUATIONS} or an Actuation object; got {actuation!r}"
         )

@@ -32,7 +32,12 @@ from rotomorph.analysis.shape import edge_end_to_end_ratios, end_to_end_ratio
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidParameterError
 from rotomorph.geometry import parallel_transport, unit
-from rotomorph.lattice.actuation import Actuation, get_actuation
+from rotomorph.lattice.actuation import (
+    DEFAULT_ACTUATION,
+    Actuation,
+    default_stiffness,
+    get_actuation,
+)
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
 from rotomorph.rod.assembly import reference_twist
 from rotomorph.rod.model import Model
@@ -301,9 +306,9 @@ def _measure(
 def heat_lattice(
     lattice: Lattice,
     *,
-    actuation: str | Actuation = "swapped",
+    actuation: str | Actuation = DEFAULT_ACTUATION,
     steps: int = 16,
-    stiffness: Stiffness = "paper",
+    stiffness: Stiffness | None = None,
     supports: SupportsName = "free",
     gravity: Gravity | None = None,
     seed: int = 0,
@@ -318,12 +323,15 @@ def heat_lattice(
     lattice
         The printed design (:func:`rotomorph.design.lattices.sinusoidal_lattice`).
     actuation
-        A name of :data:`rotomorph.lattice.actuation.ACTUATIONS` (default ``"swapped"``,
-        notes Q4) or an actuation object; its ``start``/``end`` set the ramp.
+        A name of :data:`rotomorph.lattice.actuation.ACTUATIONS` (default ``"program"``: every
+        line's natural field from its print program at the ramp temperature) or an actuation
+        object; its ``start``/``end`` set the ramp.
     steps
         Equal ramp steps (>= 1).
     stiffness
-        ``"paper"`` or ``"janus"`` (:func:`rotomorph.lattice.model.lattice_model`).
+        ``"paper"`` or ``"janus"`` (:func:`rotomorph.lattice.model.lattice_model`); default
+        :func:`~rotomorph.lattice.actuation.default_stiffness` (the Janus section of the
+        actuation's own materials model for ``program``/``thermal``, ``"paper"`` otherwise).
     supports
         ``"free"`` (default; the paper's free lattice), ``"clamped-boundary"`` (every segment
         touching a perimeter branch node clamped: position and frame fixed) or
@@ -364,7 +372,8 @@ def heat_lattice(
         raise InvalidParameterError(
             "supports", "gravity needs a support: use 'pinned-centre' or 'clamped-boundary'"
         )
-    lm = lattice_model(lattice, stiffness=stiffness)
+    stiffness, fm = default_stiffness(act, stiffness)
+    lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
     loads = Loads(gravity=gravity)
     dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
     initial = perturbed_state(lm.model, dz)
@@ -429,11 +438,11 @@ def _stable_flag(result: StaticResult) -> bool | None:
 def free_edge_ratio(
     lattice: Lattice,
     *,
-    actuation: str | Actuation = "swapped",
+    actuation: str | Actuation = DEFAULT_ACTUATION,
     parameter: float | None = None,
     edge: int = 0,
     steps: int = 8,
-    stiffness: Stiffness = "paper",
+    stiffness: Stiffness | None = None,
 ) -> float:
     """End-to-end ratio L/L0 of one lattice edge printed alone and actuated freely.
 
@@ -453,7 +462,8 @@ def free_edge_ratio(
         Which lattice edge (its mode decides expanding/contracting).
     """
     act = get_actuation(actuation)
-    lm = edge_model(lattice, edge, stiffness=stiffness)
+    stiffness, fm = default_stiffness(act, stiffness)
+    lm = edge_model(lattice, edge, stiffness=stiffness, filament_model=fm)
     end = act.end if parameter is None else float(parameter)
     values = np.linspace(act.start, end, int(steps) + 1)[1:]
     path = continuation(

@@ -189,6 +189,9 @@ class LatticeModel:
         ``(S,)`` True on ordinary rod vertices (False on junction pairs).
     side_basis
         ``(Δκ1, Δκ2)`` per unit curvature toward the active side (:func:`active_side_basis`).
+    segments
+        ``(E,)`` the lattice network segment each model edge is (all of them for
+        :func:`lattice_model`, one edge's for :func:`edge_model`).
     """
 
     lattice: Lattice
@@ -197,6 +200,7 @@ class LatticeModel:
     expanding: BoolArray
     rod_vertex: BoolArray
     side_basis: tuple[FloatArray, FloatArray]
+    segments: IntArray | None = None
 
 
 def _build(
@@ -239,6 +243,7 @@ def _build(
         expanding=expanding,
         rod_vertex=rod_vertex,
         side_basis=active_side_basis(side, model),
+        segments=segments,
     )
 
 

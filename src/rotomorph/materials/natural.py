@@ -34,12 +34,12 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 
 from rotomorph import geometry
-from rotomorph._typing import FloatArray
+from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidDesignError, InvalidParameterError, MaterialError
 from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection, filament_section
 from rotomorph.materials.material import Material, get_material
@@ -326,7 +326,148 @@ def _vertex_increments(
     _, kappa, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
     tb = geometry.unit(t[:-1] + t[1:])
     vec = kappa[:, :1] * n_v + kappa[:, 1:2] * np.cross(tb, n_v)
+    if getattr(program, "step_flips", False) and vn is not None and len(vec) > 2:
+        # a vertex in the middle of a split step flip (both its edges flip) is the step
+        # itself: half of its cell on each side, so its increment is the mean of its
+        # neighbours' (about zero), not K toward the mid-flip normal (out of plane)
+        mid = _mid_flip(np.asarray(vn, dtype=float))[1:-1]
+        mid[0] = mid[-1] = False
+        vec[mid] = 0.5 * (vec[np.flatnonzero(mid) - 1] + vec[np.flatnonzero(mid) + 1])
     return vec, np.asarray(dtau, dtype=float).reshape(-1)
+
+
+def _flip_edges(vertex_normals: FloatArray) -> BoolArray:
+    """Edges whose two vertex normals are 90° or more apart (a flip of the active side)."""
+    dots = np.einsum("ij,ij->i", vertex_normals[:-1], vertex_normals[1:])
+    return cast(BoolArray, dots <= 1e-9)
+
+
+def _mid_flip(vertex_normals: FloatArray) -> BoolArray:
+    """Vertices ``(N,)`` whose edges on both sides are flip edges."""
+    flip = _flip_edges(vertex_normals)
+    mid = np.zeros(len(vertex_normals), dtype=bool)
+    mid[1:-1] = flip[:-1] & flip[1:]
+    return mid
+
+
+def _step_flip_normals(
+    normals: FloatArray, vertex_normals: FloatArray, t: FloatArray
+) -> FloatArray:
+    """Edge normals of a program whose flips are ideal steps.
+
+    A flip edge lies on the side of its end that is not itself mid-flip (a split flip steps at
+    that vertex); an edge holding a whole flip steps at its midpoint and its principal axis is
+    that of either end (their sign-aligned mean). Other edges keep their normals.
+    """
+    flip = _flip_edges(vertex_normals)
+    if not flip.any():
+        return normals
+    mid = _mid_flip(vertex_normals)
+    a, b = vertex_normals[:-1], vertex_normals[1:]
+    aligned = a + np.sign(np.einsum("ij,ij->i", a, b) + 1e-300)[:, None] * b
+    axis = np.where(mid[:-1, None], b, np.where(mid[1:, None], a, aligned))
+    axis = axis - np.einsum("ij,ij->i", axis, t)[:, None] * t
+    out = normals.copy()
+    out[flip] = geometry.unit(axis[flip])
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class ActuationIncrements:
+    """What heating adds to the printed natural state of one filament (frame-free form).
+
+    Every lattice edge and every single filament gets its actuation from here, so both go
+    through the same chain: print program → section (materials, temperature) → increments.
+
+    Attributes
+    ----------
+    curvature
+        ``(N-2, 3)`` natural-curvature vectors added at the interior vertices (1/mm per printed
+        length, toward the side the filament bends to), x(T) included.
+    twist
+        ``(N-2,)`` eigen-twist added at the interior vertices (1/mm per printed length).
+    axial_strain
+        ``(N-1,)`` natural centre-line strain x·ε_c of each edge (model's measure).
+    stretch
+        ``(N-1,)`` rest length / printed length of each edge.
+    normals
+        ``(N-1, 3)`` interface normals n of the edges (into the active phase).
+    omega_star
+        ``(N-1,)`` signed director-helix rotation number of the edges.
+    actuation
+        x(T) ∈ [0, 1].
+    measure
+        Strain measure of ``axial_strain``.
+    section
+        The meshed cross-section (stiffnesses).
+    """
+
+    curvature: FloatArray
+    twist: FloatArray
+    axial_strain: FloatArray
+    stretch: FloatArray
+    normals: FloatArray
+    omega_star: FloatArray
+    actuation: float
+    measure: Literal["hencky", "engineering"]
+    section: FilamentSection
+
+
+def actuation_increments(
+    program: Any,
+    materials: Mapping[str, Material] | None = None,
+    temperature: float = 175.0,
+    *,
+    model: FilamentModel | None = None,
+) -> ActuationIncrements:
+    """Actuation increments of a printed filament at ``temperature`` (°C).
+
+    Parameters and errors as :func:`natural_field`. The section quantities (K_J, K_2, Δτ) are
+    sampled at the vertices with the vertex's speed and rotation, toward the vertex interface
+    normal (see ``_vertex_increments``); the centre-line strain per edge.
+    """
+    model = FilamentModel() if model is None else model
+    pts, speed, rot, alpha, radius, frac = _program_arrays(program)
+    # the rotation that winds the director helix (ideal step flips wind none)
+    rot = np.asarray(getattr(program, "director_rotation", rot), dtype=float).reshape(-1)
+    active = _material(program.active_material, materials, "active")
+    passive = _material(program.passive_material, materials, "passive")
+    x = float(
+        actuation_fraction(
+            temperature,
+            active.transition_temperature,  # type: ignore[arg-type]
+            model.transition_width,
+            direction=model.direction,
+            hysteresis=model.hysteresis,
+        )
+    )
+    edge_speed = 0.5 * (speed[:-1] + speed[1:])
+    edge_rot = 0.5 * (rot[:-1] + rot[1:])
+    omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
+    section = model.section(active, passive, radius, frac)
+    e_par, e_perp, eps_p = model.strains(edge_speed, passive)
+    eps_c, _, _ = section.natural_strains(omega_star, e_par, e_perp, eps_p)
+    d1 = geometry.space_parallel_directors(pts)
+    t = geometry.unit(np.diff(pts, axis=0))
+    normals = geometry.rotate_about_tangent(d1, t, alpha)
+    vn = getattr(program, "vertex_interface_normals", None)
+    if getattr(program, "step_flips", False) and vn is not None:
+        normals = _step_flip_normals(normals, np.asarray(vn, dtype=float), t)
+    vec, dtw = _vertex_increments(program, t, normals, speed, rot, radius, model, section, passive)
+    measure = model.strain_model.measure
+    axial = x * np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t))
+    stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
+    return ActuationIncrements(
+        curvature=x * vec,
+        twist=x * dtw,
+        axial_strain=axial,
+        stretch=stretch,
+        normals=normals,
+        omega_star=np.asarray(omega_star, dtype=float),
+        actuation=x,
+        measure=measure,
+        section=section,
+    )
 
 
 def natural_field(
@@ -362,55 +503,34 @@ def natural_field(
     MaterialError
         Unknown material names or an active/passive mix-up.
     """
-    model = FilamentModel() if model is None else model
-    pts, speed, rot, alpha, radius, frac = _program_arrays(program)
-    active = _material(program.active_material, materials, "active")
-    passive = _material(program.passive_material, materials, "passive")
-    x = float(
-        actuation_fraction(
-            temperature,
-            active.transition_temperature,  # type: ignore[arg-type]
-            model.transition_width,
-            direction=model.direction,
-            hysteresis=model.hysteresis,
-        )
-    )
-    edge_speed = 0.5 * (speed[:-1] + speed[1:])
-    edge_rot = 0.5 * (rot[:-1] + rot[1:])
-    omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
-    section = model.section(active, passive, radius, frac)
-    e_par, e_perp, eps_p = model.strains(edge_speed, passive)
-    eps_c, _, _ = section.natural_strains(omega_star, e_par, e_perp, eps_p)
-
-    d1 = geometry.space_parallel_directors(pts)
+    inc = actuation_increments(program, materials, temperature, model=model)
+    pts = np.asarray(program.points, dtype=float)
     t = geometry.unit(np.diff(pts, axis=0))
-    normals = geometry.rotate_about_tangent(d1, t, alpha)
     # m1 = sign * n: the same principal axis, but without the pi jumps of n where the active
     # side flips (a DER vertex averages its two edges' frames, which vanish across a pi jump
     # and would leave a stiffness-free hinge there); the side is carried by the sign
-    sign = continuous_sign(normals, t)
-    directors = sign[:, None] * normals
+    sign = continuous_sign(inc.normals, t)
+    directors = sign[:, None] * inc.normals
     k1, k2, tw, vor = geometry.polyline_strains(pts, directors)
-    _check_handedness(k1, k2, tw, omega_star)
-    vec, dtw = _vertex_increments(program, t, normals, speed, rot, radius, model, section, passive)
-    dk1, dk2 = geometry.curvature_increment(t[:-1], t[1:], directors[:-1], directors[1:], vec)
+    _check_handedness(k1, k2, tw, inc.omega_star)
+    dk1, dk2 = geometry.curvature_increment(
+        t[:-1], t[1:], directors[:-1], directors[1:], inc.curvature
+    )
     lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    measure = model.strain_model.measure
-    axial = x * eps_c
-    stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
+    section = inc.section
     ones = np.ones(len(lengths))
     return NaturalField(
         directors=directors,
-        curvature1=k1 / vor + x * dk1,
-        curvature2=k2 / vor + x * dk2,
-        twist=tw / vor + x * dtw,
+        curvature1=k1 / vor + dk1,
+        curvature2=k2 / vor + dk2,
+        twist=tw / vor + inc.twist,
         voronoi_length=vor,
-        rest_length=lengths * stretch,
-        axial_strain=axial,
+        rest_length=lengths * inc.stretch,
+        axial_strain=inc.axial_strain,
         bending_stiffness1=section.bending_stiffness1 * ones,
         bending_stiffness2=section.bending_stiffness2 * ones,
         twist_stiffness=section.twist_stiffness * ones,
         axial_stiffness=section.axial_stiffness * ones,
-        actuation=x,
-        measure=measure,
+        actuation=inc.actuation,
+        measure=inc.measure,
     )

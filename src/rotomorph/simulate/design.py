@@ -217,6 +217,28 @@ def _simulate_filaments(
     )
 
 
+#: Lattice actuation used when none is given (as rotomorph.lattice.actuation.DEFAULT_ACTUATION,
+#: repeated here so that filament-only runs do not import the lattice package).
+DEFAULT_ACTUATION = "program"
+
+
+def lattice_assumptions(lattice: Any) -> dict[str, Any]:
+    """The lattice's geometric inputs that the paper does not give, with their values.
+
+    Every lattice output depends on them (area, curvature, clearance); they are assumptions,
+    not measurements, and results carry them so that no number hides them.
+    """
+    from rotomorph.design.lattices import ASSUMED_FIELDS
+
+    values = {name: float(getattr(lattice, name)) for name in ASSUMED_FIELDS}
+    return {
+        **{f"{k}_mm": v for k, v in values.items()},
+        "wavelength_mm": float(lattice.spacing),
+        "note": "not given in the paper: cell size l (= the sine wavelength), amplitude A "
+        "and filament radius R are assumed; every lattice number depends on them",
+    }
+
+
 def _simulate_lattice(
     design: Any, *, steps: int, actuation: str, progress: Progress | None
 ) -> DesignSimulation:
@@ -240,7 +262,7 @@ def _simulate_lattice(
     phase_log.info("analysis: curvature changes, areas")
     pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
     rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])
-    ramp = "temperature" if actuation == "thermal" else "actuation"
+    ramp = "temperature" if actuation in ("thermal", "program") else "actuation"
     scalars = {
         ramp: np.asarray(res.parameter, dtype=float),
         "energy": np.asarray(res.energy, dtype=float),
@@ -264,6 +286,7 @@ def _simulate_lattice(
         "edge_mode": list(lattice.edge_mode),
         "final": {k: float(v[-1]) for k, v in scalars.items()},
         "actuation_rule": res.actuation,
+        "assumptions": lattice_assumptions(lattice),
         "lattice_wall_time_s": float(np.sum(res.wall_time)),
     }
     net = lattice.network
@@ -315,7 +338,8 @@ def simulate_design(
         faster. Filaments only.
     actuation
         Lattice actuation rule (:data:`rotomorph.lattice.actuation.ACTUATIONS`; default
-        ``"swapped"``). Refused for filaments.
+        ``"program"``: each line's natural field from its print program). Refused for
+        filaments.
     progress
         Called with the number of finished units (see :func:`step_count`).
 
@@ -345,7 +369,7 @@ def simulate_design(
     )
     if design.lattice is not None:
         sim = _simulate_lattice(
-            design, steps=steps, actuation=actuation or "swapped", progress=progress
+            design, steps=steps, actuation=actuation or DEFAULT_ACTUATION, progress=progress
         )
     else:
         if spacing is not None:
