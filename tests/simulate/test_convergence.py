@@ -15,7 +15,7 @@ from rotomorph.simulate.filament import simulate_filament
 
 @pytest.fixture(scope="module")
 def model():
-    return paper_calibration()[1].model
+    return paper_calibration().chosen.model
 
 
 def _sinusoid(side: str, spacing: float) -> Filament:
@@ -38,7 +38,7 @@ def test_contracting_sinusoid_converges_with_node_spacing(model):
     # (out-of-plane curvature K_J h per flip) and the ratio moved 0.2 -> 0.5 with h
     # and the nozzle's flip rotation wound a spurious director helix over the two vertices
     # around each flip (eigen-twist of order 0.3 rad per flip at h = 0.45 mm)
-    res = at_two_resolutions(lambda h: _ratio(_sinusoid("inner", h), model), 0.2, rtol=2e-3)
+    res = at_two_resolutions(lambda h: _ratio(_sinusoid("inner", h), model), 0.2, rtol=1e-2)
     assert res.converged, res
     assert 0.2 < res.value < 0.6
 
