@@ -230,33 +230,50 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _machine(args: argparse.Namespace, *, note: bool = True) -> Any:
+    """The --machine profile, else the built-in default (stated on stderr with ``note``)."""
     from rotomorph.io.machine import MachineProfile, load_machine_profile
 
-    if args.machine is None:
-        machine = MachineProfile(dialect=getattr(args, "dialect", None) or "aerotech")
-        if note:
-            sys.stderr.write(
-                "rotomorph: note: no --machine given; using the built-in default machine "
-                f"'{machine.name}' (envelope {list(machine.envelope_max)} mm, max feed "
-                f"{machine.max_feed:g} mm/s, max rotation {machine.max_rotation:g} rad/s); "
-                "stated in the header\n"
+    dialect = getattr(args, "dialect", None)
+    if args.machine is not None:
+        machine = load_machine_profile(_existing_file(args.machine, "--machine"))
+        if dialect is not None and dialect != machine.dialect:
+            raise UsageError(
+                f"--dialect {dialect}: the profile {args.machine} is for "
+                f"'{machine.dialect}'; change its 'dialect' key or drop --dialect"
             )
         return machine
-    machine = load_machine_profile(_existing_file(args.machine, "--machine"))
-    dialect = getattr(args, "dialect", None)
-    if dialect is not None and dialect != machine.dialect:
-        from dataclasses import replace
-
-        machine = replace(machine, dialect=dialect)
+    machine = MachineProfile(dialect=dialect or "aerotech")
+    if note:
+        sys.stderr.write(
+            "rotomorph: note: no --machine given; using the built-in default machine "
+            f"'{machine.name}' ({machine.dialect}, envelope {list(machine.envelope_max)} mm, "
+            f"max feed {machine.max_feed:g} mm/s, max rotation {machine.max_rotation:g} rad/s); "
+            "stated in the header\n"
+        )
     return machine
 
 
 def _cmd_gcode(args: argparse.Namespace) -> int:
-    from rotomorph.io.gcode import write_gcode
+    from rotomorph.io.gcode import plan_programs, write_gcode
+    from rotomorph.io.gcode_read import check_gcode
 
+    if args.check is not None:
+        if args.design is not None or args.output is not None or args.preview:
+            raise UsageError("--check FILE takes only --machine (no DESIGN, -o or --preview)")
+        if args.machine is None:
+            raise UsageError("--check FILE needs --machine PROFILE.toml to check against")
+        path = _existing_file(args.check, "--check")
+        report = check_gcode(path.read_text(encoding="utf-8", errors="replace"), _machine(args))
+        _print(
+            f"{args.check}: ok: {len(report.filaments)} filament(s), {report.moves} moves, "
+            f"rotation <= {report.max_rotation:.4g} rad/s, print feed "
+            f"{report.feed_range[0]:.4g}..{report.feed_range[1]:.4g} mm/s, rotary within "
+            f"{report.max_start_turns:.3g} turn at filament starts, ~{report.time:.0f} s"
+        )
+        return EXIT_OK
+    if args.design is None or not args.output:
+        raise UsageError("gcode: give DESIGN.toml and -o FILE (or --check FILE)")
     design = _load_design(args.design)
-    if not args.output:
-        raise UsageError("-o/--output: empty path; give a file name")
     out = Path(args.output)
     if out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
@@ -267,6 +284,11 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     _check_materials(programs)
     write_gcode(programs, out, machine, **design.gcode_options(), layer_cure_s=args.cure)
     _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
+    if args.preview:
+        from rotomorph.plot.toolpath import save_toolpath_png
+
+        png = save_toolpath_png(plan_programs(programs, machine), out.with_suffix(".png"))
+        _print(f"wrote {png}")
     return EXIT_OK
 
 
@@ -416,12 +438,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_cmd_validate)
 
-    p = sub.add_parser("gcode", help="write G-code for a design", description="Write G-code.")
-    p.add_argument("design", metavar="DESIGN.toml")
-    p.add_argument("-o", "--output", required=True, metavar="FILE", help="G-code file to write")
-    p.add_argument("--dialect", choices=DIALECTS, help="default: the machine's, else aerotech")
-    p.add_argument("--machine", metavar="PROFILE.toml", help="machine profile (limits, axes)")
+    p = sub.add_parser(
+        "gcode",
+        help="write G-code for a design, or check a program",
+        description="Write G-code for DESIGN.toml (-o FILE), or read a program back strictly "
+        "and check it against a machine profile (--check FILE --machine PROFILE.toml).",
+    )
+    p.add_argument("design", nargs="?", metavar="DESIGN.toml")
+    p.add_argument("-o", "--output", metavar="FILE", help="G-code file to write")
+    p.add_argument("--dialect", choices=DIALECTS, help="built-in machine's dialect (no --machine)")
+    p.add_argument(
+        "--machine", metavar="PROFILE.toml", help="machine profile (see examples/machines)"
+    )
     p.add_argument("--cure", type=float, default=0.0, metavar="S", help="UV dwell per layer (s)")
+    p.add_argument("--preview", action="store_true", help="also write FILE.png (toolpath)")
+    p.add_argument("--check", metavar="FILE", help="check an existing program instead")
     p.set_defaults(func=_cmd_gcode)
 
     p = sub.add_parser(

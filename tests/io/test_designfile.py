@@ -96,7 +96,11 @@ def test_save_load_round_trip_is_atomic(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["copy.toml"]
     again = load_design(out)
     assert again == design and again.sha256() == design.sha256()
-    assert design.gcode_options() == {"pressures": (30.0, 30.0), "design_hash": design.sha256()}
+    from rotomorph.io.gcode import Process
+
+    options = design.gcode_options()
+    assert options["design_hash"] == design.sha256()
+    assert options["process"] == [Process(30.0, 30.0)] * len(design.to_programs())
 
 
 def test_controls_per_segment():
@@ -142,7 +146,7 @@ def test_schema_export():
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_example_prints_on_a_default_machine(path):
-    from rotomorph.io.gcode import gcode_text
+    from rotomorph.io.gcode import gcode_text, plan_programs
     from rotomorph.io.gcode_read import parse_gcode
     from rotomorph.io.machine import MachineProfile
 
@@ -153,8 +157,10 @@ def test_example_prints_on_a_default_machine(path):
         gcode_text(progs, machine, layer_cure_s=600, **design.gcode_options()), machine
     )
     assert len(read) == len(progs)
+    printed = plan_programs(progs, machine)
     assert all(
-        np.allclose(r.program.points, p.points, atol=1e-4) for r, p in zip(read, progs, strict=True)
+        np.allclose(r.program.points, p.points, atol=1e-4)
+        for r, p in zip(read, printed, strict=True)
     )
 
 

@@ -13,7 +13,7 @@ from rotomorph.cli import EXIT_OK, EXIT_USAGE, main
 from rotomorph.design.path import Path as PrintPath
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidParameterError, MachineLimitError
-from rotomorph.io.gcode import gcode_text
+from rotomorph.io.gcode import Process, gcode_text
 from rotomorph.io.gcode_read import parse_gcode
 from rotomorph.io.machine import MachineProfile, load_machine_profile
 
@@ -136,7 +136,8 @@ def test_travel_never_crosses_the_printed_part(dialect):
         words = {w[0]: float(w[1:]) for w in line.split()[1:] if w[0] in "XYZ"}
         if line.startswith("G1"):
             z = words.get("Z", z)
-            printed_top = max(printed_top, z)
+            if "X" in words:  # a print move (the lowering G1 moves only Z and the rotary axis)
+                printed_top = max(printed_top, z)
         elif line.startswith("G0"):
             if "Z" in words:
                 z = words["Z"]
@@ -159,7 +160,7 @@ def test_feed_below_the_minimum_is_refused(speed):
     with pytest.raises(MachineLimitError, match="min_feed"):
         gcode_text([prog], MachineProfile())
     ok = gcode_text([prog], MachineProfile(min_feed=1e-5))
-    feeds = re.findall(r"^G1 .* F(\S+)$", ok, flags=re.M)
+    feeds = re.findall(r"^G1 (?:.* )?F(\S+)$", ok, flags=re.M)  # aerotech: G1 F lines
     assert all(re.fullmatch(r"\d+\.?\d*", f) for f in feeds)  # no exponent notation
     feeds = [float(f) for f in feeds]
     assert feeds and min(feeds) == pytest.approx(speed, rel=1e-9)
@@ -187,7 +188,7 @@ def test_every_limit_names_its_profile_key(machine, pressures, key):
     line = PrintPath.line((10, 10, 0.3), (12, 10, 0.3), 0.5)
     prog = PrintProgram.from_rotation(line, 3.0, 10.0)
     with pytest.raises(MachineLimitError, match=f"machine profile key '{key}'"):
-        gcode_text([prog], machine, pressures=pressures)
+        gcode_text([prog], machine, process=Process(*pressures))
 
 
 def test_profile_values_are_range_checked():
@@ -216,3 +217,47 @@ def test_default_machine_is_stated(tmp_path, capsys):
     assert main(["gcode", str(design), "-o", str(out), "--machine", str(prof)]) == EXIT_OK
     assert "built-in" not in capsys.readouterr().err
     assert "; machine: lab, profile lab.toml" in out.read_text()
+
+
+MACHINES = Path(__file__).parents[2] / "examples" / "machines"
+EXAMPLES = Path(__file__).parents[2] / "examples" / "designs"
+
+
+def test_cli_preview_and_check(tmp_path, capsys):
+    from PIL import Image
+
+    out = tmp_path / "dome.gcode"
+    machine = str(MACHINES / "linuxcnc.toml")
+    design = str(EXAMPLES / "lattice_dome.toml")
+    assert main(["gcode", design, "-o", str(out), "--machine", machine, "--preview"]) == EXIT_OK
+    img = np.asarray(Image.open(out.with_suffix(".png")).convert("RGB"), dtype=float)
+    assert img.std() > 5.0 and np.sum(np.ptp(img, axis=2) > 40) > 500
+    capsys.readouterr()
+    assert main(["gcode", "--check", str(out), "--machine", machine]) == EXIT_OK
+    assert "ok: 30 filament(s)" in capsys.readouterr().out
+    bad = tmp_path / "bad.gcode"
+    bad.write_text(out.read_text().replace("M65 P0\n", "", 1))
+    assert main(["gcode", "--check", str(bad), "--machine", machine]) == EXIT_USAGE
+    assert "line " in capsys.readouterr().err
+    other = str(MACHINES / "marlin.toml")
+    assert main(["gcode", "--check", str(out), "--machine", other]) == EXIT_USAGE
+    assert main(["gcode", "--check", str(out)]) == EXIT_USAGE
+    assert "--machine" in capsys.readouterr().err
+    code = main(["gcode", design, "-o", str(out), "--machine", machine, "--dialect", "marlin"])
+    assert code == EXIT_USAGE and "'dialect'" in capsys.readouterr().err
+
+
+def test_design_file_process_per_filament(tmp_path):
+    design = tmp_path / "d.toml"
+    design.write_text(
+        "schema_version = 1\n[nozzle]\nactive_pressure = 20.0\nprime_dwell = 0.3\n"
+        "[[filaments]]\nspeed = 0.25\nactive_pressure = 12.0\npassive_pressure = 8.0\n"
+        "start = [10.0, 10.0, 0.0]\nspacing = 0.5\nsegments = [{ kind = 'line', length = 2.0 }]\n"
+        "[[filaments]]\nspeed = 3.0\nactive_fraction = 1.0\nrelease_dwell = 0.2\n"
+        "start = [10.0, 15.0, 0.0]\nspacing = 0.5\nsegments = [{ kind = 'line', length = 2.0 }]\n"
+    )
+    out = tmp_path / "p.gcode"
+    assert main(["gcode", str(design), "-o", str(out)]) == EXIT_OK
+    read = parse_gcode(out.read_text(), MachineProfile())
+    assert [r.pressure for r in read] == [{"active": 12.0, "passive": 8.0}, {"active": 20.0}]
+    assert [(r.prime_dwell, r.release_dwell) for r in read] == [(0.3, 0.0), (0.3, 0.2)]

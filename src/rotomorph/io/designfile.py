@@ -72,6 +72,7 @@ from rotomorph.io.design_limits import (
     segment_edges,
     sinusoid_length,
 )
+from rotomorph.io.gcode import Process
 from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
 from rotomorph.materials.material import get_material, known_materials
 
@@ -211,7 +212,26 @@ SegmentModel = Annotated[
 ]
 
 
-class Filament(_Control):
+class _Process(_Model):
+    """Per-filament process settings (unset: the ``[nozzle]`` table's)."""
+
+    active_pressure: float | None = _ranged("pressure", None, "active channel pressure")
+    passive_pressure: float | None = _ranged("pressure", None, "passive channel pressure")
+    prime_dwell: float | None = Field(None, ge=0, le=3600, description="s after pressure-on")
+    release_dwell: float | None = Field(None, ge=0, le=3600, description="s after pressure-off")
+
+    def process(self, nozzle: Nozzle) -> Process:
+        """The :class:`~rotomorph.io.gcode.Process` of this filament (falls back to nozzle)."""
+        keys = ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell")
+        return Process(
+            **{
+                k: getattr(nozzle, k) if getattr(self, k) is None else getattr(self, k)
+                for k in keys
+            }
+        )
+
+
+class Filament(_Control, _Process):
     """One filament: a chain of segments and how to print it."""
 
     name: str = Field("", max_length=200)
@@ -363,7 +383,7 @@ def _geometry(seg: Any) -> Any:
     return Polyline(np.array(seg.points))
 
 
-class LatticeModel(_Model):
+class LatticeModel(_Process):
     """The paper's sinusoidal lattice (:func:`rotomorph.design.lattices.sinusoidal_lattice`)."""
 
     n: int = _ranged("lattice_n", 5, "branch nodes per side")
@@ -449,6 +469,8 @@ class Nozzle(_Model):
     diameter: float = _ranged("nozzle_diameter", 1.0, "nozzle diameter")
     active_pressure: float = _ranged("pressure", 30.0, "active channel pressure")
     passive_pressure: float = _ranged("pressure", 30.0, "passive channel pressure")
+    prime_dwell: float = Field(0.0, ge=0, le=3600, description="s after pressure-on")
+    release_dwell: float = Field(0.0, ge=0, le=3600, description="s after pressure-off")
 
 
 class Design(_Model):
@@ -492,9 +514,18 @@ class Design(_Model):
         return sorted(progs, key=lambda p: p.layer)
 
     def gcode_options(self) -> dict[str, Any]:
-        """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (pressures, hash)."""
-        pressure = (self.nozzle.active_pressure, self.nozzle.passive_pressure)
-        return {"pressures": pressure, "design_hash": self.sha256()}
+        """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (process, hash).
+
+        One :class:`~rotomorph.io.gcode.Process` per program of :meth:`to_programs`, in the
+        same order: each filament's or the lattice's pressures and dwells, else the nozzle's.
+        """
+        owners: list[tuple[int, _Process]] = [(f.layer, f) for f in self.filaments]
+        if self.lattice is not None:
+            lattice = self.lattice
+            owners += [(p.layer, lattice) for p in lattice.to_lattice().print_programs()]
+        owners.sort(key=lambda pair: pair[0])  # stable, as to_programs
+        process = [owner.process(self.nozzle) for _, owner in owners]
+        return {"process": process, "design_hash": self.sha256()}
 
     def sha256(self) -> str:
         """sha256 (hex) of the canonical JSON of the design."""

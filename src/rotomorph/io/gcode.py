@@ -1,27 +1,38 @@
-"""G-code writer for rotational multimaterial printing (DESIGN.md section 7).
+"""G-code writer for rotational multimaterial printing.
 
-Layout of the emitted program (one block per filament, layers in order)::
+Layout of the emitted program (dialects and idioms: :mod:`rotomorph.io.machine`)::
 
-    ; header: tool version, design sha256, dialect, units, axis mapping, estimated time
-    G71 / G76 / G90           (aerotech)      or   G21 / G90 (rs274, marlin)
+    ; header: tool, design sha256, machine and its limits, dialect, units, axes, rotary
+    ;         convention, pressure channels, estimated time
+    <header_lines>                verbatim (e.g. an A3200 DVAR block), optional
+    <setup_lines>                 G71 G76 G90 | G21 G90 G94 | G21 G90
     ; layer 0
-    ; filament 0 layer=0 radius=0.3 active_fraction=0.5 active_material=lce passive_material=...
-    G0 Z<z+lift>              lift (pressures are off)
-    G0 X.. Y.. A..            travel to the start, turning the nozzle to its start angle
-    G0 Z<z>                   lower
-    <pressure active on>      explicit set-points, never toggles
-    <pressure passive on>
-    G1 X.. Y.. [Z..] A.. F..  one print move per edge: rotary axis in the same block,
-    ...                       cumulative (unwrapped) angle, so dα_n/ds = ω/v on every move
-    <pressure active 0>       explicit off
-    <pressure passive 0>
+    ; filament 0 layer=0 radius=0.3 active_fraction=0.5 active_material=lce passive_material=…
+    G0 Z<travel>                  lift: `lift` above everything printed so far
+    G0 X.. Y..                    travel at that height (no rotary word: G0 rates are unknown)
+    [G92 C<angle mod 360>]        re-base the rotary word (never more than a turn between
+                                  filaments)
+    G1 Z<z0> C<start> F<f>        lower while turning to the start angle, f within max_rotation
+    <pressure on>                 only the channels the filament uses (pure active: one)
+    [G4 <prime dwell>]
+    G1 X.. Y.. [Z..] C.. [F..]    one move per edge, rotary in the same block, cumulative angle
+    ...
+    <pressure off>
+    [G4 <release dwell>]
     ; end filament 0
-    [; UV cure after layer 0: dwell] (optional)
-    M2
+    [lift, UV cure dwell after each layer]
+    G0 Z<top + lift>
+    [G92 C<restored>] <end_lines> <footer_lines>
 
-The move that leaves vertex i runs at ``speed[i]`` (``PrintProgram`` convention). The writer
-refuses, before writing anything, a program that leaves the envelope or exceeds the feed,
-rotation or pressure limits (:class:`~rotomorph.errors.MachineLimitError`).
+Precision: positions and angles are written with 6 decimals (trailing zeros dropped), feeds
+with 10 significant digits; each move's angle increment is the design's dα/ds times the
+*written* move length, so dα/ds · v = ω holds for the numbers in the file on every move (to the
+last decimal of the angle word), not only for the design's floats.
+
+Safety: nothing is written unless every vertex and travel lies in the envelope, every feed is
+within [min_feed, max_feed], every rotary move (travel included) within max_rotation, every
+pressure within the profile's range, and every name one word of printable ASCII; the error names
+the machine-profile key to change (:class:`~rotomorph.errors.MachineLimitError`).
 """
 
 from __future__ import annotations
@@ -32,7 +43,7 @@ import json
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -41,14 +52,80 @@ import rotomorph
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidParameterError, MachineLimitError, MaterialError
 from rotomorph.io.atomic import atomic_write_text
-from rotomorph.io.machine import MachineProfile, check_line
+from rotomorph.io.machine import MachineProfile, check_line, fill_template
+from rotomorph.io.print_order import machine_order
 from rotomorph.materials.material import get_material, known_materials
 
-__all__ = ["check_materials", "gcode_text", "programs_sha256", "write_gcode"]
+__all__ = [
+    "Process",
+    "check_materials",
+    "gcode_text",
+    "pressure_lines",
+    "programs_sha256",
+    "write_gcode",
+]
 
-Pressure = tuple[float, float]
 _EPS = 1e-9
 _DIGITS = 6  # decimals of position and angle words (mm, deg or rad)
+
+
+class _Num(float):
+    """A float that formats without trailing zeros when a template gives no format spec."""
+
+    def __format__(self, spec: str) -> str:
+        return _num(self) if spec == "" else float.__format__(self, spec)
+
+
+def _num(x: float, digits: int = _DIGITS) -> str:
+    """``x`` with at most ``digits`` decimals, trailing zeros dropped, never ``-0``."""
+    s = f"{x:.{digits}f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def _feed(x: float) -> str:
+    """A feed word's number: 10 significant digits, positional (never ``0``, never ``1e-05``)."""
+    return np.format_float_positional(x, precision=10, unique=True, fractional=False, trim="-")
+
+
+@dataclass(frozen=True)
+class Process:
+    """How one filament is extruded.
+
+    Parameters
+    ----------
+    active_pressure, passive_pressure
+        Set-points (psi) of the active and passive channels. Only the channels a filament uses
+        are driven: ``active_fraction = 1`` drives the active channel alone, ``0`` the passive
+        one alone (the other pressure is then ignored).
+    prime_dwell
+        Dwell after pressure-on before the first move (s), so the ink reaches the tip.
+    release_dwell
+        Dwell after pressure-off before the lift (s), so the flow stops before the nozzle moves.
+    """
+
+    active_pressure: float = 30.0
+    passive_pressure: float = 30.0
+    prime_dwell: float = 0.0
+    release_dwell: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise InvalidParameterError(
+                    f"Process.{name}", f"must be a finite number; got {v!r}"
+                )
+            if v < 0:
+                raise InvalidParameterError(f"Process.{name}", f"must be >= 0; got {v!r}")
+
+    def channels(self, active_fraction: float) -> list[tuple[str, float]]:
+        """``(role, psi)`` of the channels a filament with ``active_fraction`` drives."""
+        out = []
+        if active_fraction > 0:
+            out.append(("active", float(self.active_pressure)))
+        if active_fraction < 1:
+            out.append(("passive", float(self.passive_pressure)))
+        return out
 
 
 def programs_sha256(programs: Sequence[PrintProgram]) -> str:
@@ -72,17 +149,6 @@ def programs_sha256(programs: Sequence[PrintProgram]) -> str:
     ]
     blob = json.dumps(data, sort_keys=True, separators=(",", ":")).encode()
     return hashlib.sha256(blob).hexdigest()
-
-
-def _num(x: float, digits: int = 6) -> str:
-    """``x`` with at most ``digits`` decimals, trailing zeros dropped, never ``-0``."""
-    s = f"{x:.{digits}f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
-
-
-def _feed(x: float) -> str:
-    """A feed word's number: 10 significant digits, positional (never ``0``, never ``1e-05``)."""
-    return np.format_float_positional(x, precision=10, unique=True, fractional=False, trim="-")
 
 
 def check_materials(programs: Sequence[PrintProgram]) -> None:
@@ -111,164 +177,195 @@ def check_materials(programs: Sequence[PrintProgram]) -> None:
                 ) from None
 
 
-def _pressures(pressures: Pressure | Sequence[Pressure], n: int) -> list[Pressure]:
-    arr = np.asarray(pressures, dtype=float)
-    if arr.shape == (2,):
-        arr = np.broadcast_to(arr, (n, 2))
-    if arr.shape != (n, 2):
+def pressure_lines(m: MachineProfile, port: int, psi: float, on: bool) -> list[str]:
+    """The lines that turn channel ``port`` on at ``psi`` (or off) in the profile's idiom."""
+    if m.pressure_idiom == "alicat":
+        return [f"Call setAlicatPress P{port} Q{_num(psi if on else 0.0, 3)}"]
+    if m.pressure_idiom == "nordson":
+        toggle = f"Call togglePress P{port}"
+        return [f"Call setPress P{port} Q{_num(psi, 3)}", toggle] if on else [toggle]
+    values = {k: (_Num(v) if k != "pwm" else v) for k, v in m.pressure_values(psi).items()}
+    setpoint = fill_template(m.pressure_template or "", port=port, **values)
+    if not m.valve_on_template:
+        off = {k: (_Num(v) if k != "pwm" else v) for k, v in m.pressure_values(0.0).items()}
+        return [setpoint if on else fill_template(m.pressure_template or "", port=port, **off)]
+    valve = fill_template(m.valve_on_template if on else m.valve_off_template or "", port=port)
+    if not on:
+        return [valve]
+    return ([setpoint] if m.pressure_template else []) + [valve]
+
+
+def _dwell(m: MachineProfile, seconds: float) -> str:
+    return fill_template(m.dwell_template or "", s=_Num(seconds), ms=round(seconds * 1000))
+
+
+def _as_process(process: Process | Sequence[Process], n: int) -> list[Process]:
+    if isinstance(process, Process):
+        return [process] * n
+    procs = list(process)
+    if len(procs) != n or not all(isinstance(p, Process) for p in procs):
         raise InvalidParameterError(
-            "pressures",
-            f"must be (active, passive) psi or one pair per program ({n}); got shape {arr.shape}",
+            "process", f"must be one Process or one per program ({n}); got {len(procs)}"
         )
-    return [(float(a), float(p)) for a, p in arr]
+    return procs
 
 
-@dataclass(frozen=True)
-class _Written:
-    """One filament as it is written: rounded positions, angle words and feeds."""
-
-    points: np.ndarray  # (N, 3) mm, rounded to the written decimals
-    angle: np.ndarray  # (N,) rotary words (deg or rad, with the profile's sign)
-    feed: np.ndarray  # (N-1,) mm/s of the move that leaves vertex i
-    rotation: np.ndarray  # (N-1,) rad/s of each move, from the written numbers
+def _limit(where: str, what: str, key: str, hint: str) -> MachineLimitError:
+    return MachineLimitError(f"{where}: {what}; {hint} (machine profile key '{key}')")
 
 
-def _written(prog: PrintProgram, m: MachineProfile, start_angle: float) -> _Written:
-    """Round positions to :data:`_DIGITS`; carry the design's dα/ds onto the written lengths.
+@dataclass
+class _Writer:
+    """Emits lines while tracking the machine state (position, feed, angle, time)."""
 
-    The angle increments are rate × written length, so dα/ds · v = ω holds per move for the
-    numbers in the file (to the angle word's rounding), not only for the design's floats.
-    """
-    pts = np.round(prog.points, _DIGITS)
+    m: MachineProfile
+    lines: list[str] = field(default_factory=list)
+    xyz: np.ndarray | None = None
+    angle: float = 0.0  # current rotary word (program coordinates)
+    shift: float = 0.0  # total G92 re-basing of the rotary word
+    feed: float | None = None  # modal F (aerotech), mm/s
+    time: float = 0.0
+
+    def emit(self, *lines: str) -> None:
+        self.lines.extend(lines)
+
+    def dwell(self, seconds: float) -> None:
+        if seconds > 0:
+            self.emit(_dwell(self.m, seconds))
+            self.time += seconds
+
+    def _words(self, xyz: np.ndarray, angle: float | None, axes: str) -> str:
+        m = self.m
+        letters = {"x": m.x_axis, "y": m.y_axis, "z": m.z_axis}
+        words = [f"{letters[a]}{_num(xyz['xyz'.index(a)])}" for a in axes]
+        if angle is not None:
+            words.append(f"{m.rotary_axis}{_num(angle)}")
+        return " ".join(words)
+
+    def rapid(self, xyz: np.ndarray, axes: str) -> None:
+        """A travel move (no rotary word), at travel_feed on marlin; none if already there."""
+        m = self.m
+        if self.xyz is not None and all(
+            _num(a) == _num(b) for a, b in zip(xyz, self.xyz, strict=True)
+        ):
+            return
+        f = f" F{_feed(m.travel_feed * m.feed_scale)}" if m.dialect == "marlin" else ""
+        self.emit(f"G0 {self._words(xyz, None, axes)}{f}")
+        if self.xyz is not None:
+            distance = float(np.linalg.norm(xyz - self.xyz))
+            self.time += distance / m.travel_feed if math.isfinite(distance) else 0.0
+        self.xyz = xyz.copy()
+
+    def linear(self, xyz: np.ndarray, angle: float, speed: float, axes: str) -> None:
+        """A feed move with the rotary word; F on its own line (aerotech) or in the block."""
+        m = self.m
+        if m.dialect == "aerotech":
+            if self.feed != speed:
+                self.emit(f"G1 F{_feed(speed)}")
+            self.emit(f"G1 {self._words(xyz, angle, axes)}")
+        else:
+            self.emit(f"G1 {self._words(xyz, angle, axes)} F{_feed(speed * m.feed_scale)}")
+        self.feed = speed
+        assert self.xyz is not None
+        self.time += math.dist(xyz, self.xyz) / speed
+        self.xyz, self.angle = xyz.copy(), angle
+
+
+def _written_angles(prog: PrintProgram, pts: np.ndarray, start: float, scale: float) -> np.ndarray:
+    """Rotary words along ``pts`` from ``start``: the design's dα/ds times the written lengths."""
     ds_design = prog.path.edge_lengths
     ds_written = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    if np.any(ds_written <= 0):
-        i = int(np.flatnonzero(ds_written <= 0)[0])
-        raise InvalidParameterError(
-            "programs", f"move {i} is shorter than the written resolution 1e-{_DIGITS} mm"
-        )
-    rate = np.diff(prog.nozzle_angle) / ds_design  # rad/mm
-    angle = start_angle + np.concatenate([[0.0], np.cumsum(rate * ds_written)])
-    word = np.round(angle * m.rotary_scale, _DIGITS)
-    feed = prog.speed[:-1]
-    rotation = np.abs(np.diff(word) / m.rotary_scale) / ds_written * feed
-    return _Written(pts, word, feed, rotation)
-
-
-def _limit(k: int, what: str, key: str, hint: str) -> MachineLimitError:
-    return MachineLimitError(f"program {k}: {what}; {hint} (machine profile key '{key}')")
+    rate = np.diff(prog.nozzle_angle) / ds_design * scale  # words per mm
+    return np.round(start + np.concatenate([[0.0], np.cumsum(rate * ds_written)]), _DIGITS)
 
 
 def _check_program(
-    k: int, prog: PrintProgram, w: _Written, pr: Pressure, m: MachineProfile
+    k: int, prog: PrintProgram, pts: np.ndarray, words: np.ndarray, m: MachineProfile
 ) -> None:
+    where = f"program {k}"
     lo, hi = np.array(m.envelope_min), np.array(m.envelope_max)
-    out = np.flatnonzero(((w.points < lo - _EPS) | (w.points > hi + _EPS)).any(axis=1))
+    out = np.flatnonzero(((pts < lo - _EPS) | (pts > hi + _EPS)).any(axis=1))
     if out.size:
         i = int(out[0])
-        side = "envelope_max" if (w.points[i] > hi + _EPS).any() else "envelope_min"
+        key = "envelope_max" if (pts[i] > hi + _EPS).any() else "envelope_min"
         raise _limit(
-            k,
-            f"vertex {i} at {np.round(w.points[i], 4).tolist()} mm leaves the envelope "
-            f"{list(m.envelope_min)}..{list(m.envelope_max)} mm of machine {m.name!r}",
-            side,
+            where,
+            f"vertex {i} at {np.round(pts[i], 4).tolist()} mm (z_offset {m.z_offset:g} mm "
+            f"included) leaves the envelope {list(m.envelope_min)}..{list(m.envelope_max)} mm "
+            f"of machine {m.name!r}",
+            key,
             "translate the design or change",
         )
-    fast = np.flatnonzero(w.feed > m.max_feed * (1 + 1e-12))
+    ds = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    if np.any(ds <= 0):
+        i = int(np.flatnonzero(ds <= 0)[0])
+        raise InvalidParameterError(
+            "programs", f"{where}: move {i} is shorter than the written resolution 1e-6 mm"
+        )
+    feed = prog.speed[:-1]
+    fast = np.flatnonzero(feed > m.max_feed * (1 + 1e-12))
     if fast.size:
         i = int(fast[0])
         raise _limit(
-            k,
-            f"speed {w.feed[i]:g} mm/s at vertex {i} exceeds the maximum feed {m.max_feed:g} mm/s",
+            where,
+            f"speed {feed[i]:g} mm/s at vertex {i} exceeds the maximum feed {m.max_feed:g} mm/s",
             "max_feed",
             "slow the design or raise",
         )
-    slow = np.flatnonzero(w.feed < m.min_feed * (1 - 1e-12))
+    slow = np.flatnonzero(feed < m.min_feed * (1 - 1e-12))
     if slow.size:
         i = int(slow[0])
         raise _limit(
-            k,
-            f"speed {w.feed[i]:g} mm/s at vertex {i} is below the minimum feed {m.min_feed:g} mm/s",
+            where,
+            f"speed {feed[i]:g} mm/s at vertex {i} is below the minimum feed {m.min_feed:g} mm/s",
             "min_feed",
             "speed the design up or lower",
         )
-    spin = np.flatnonzero(w.rotation > m.max_rotation * (1 + 1e-9))
+    rotation = np.abs(np.diff(words) / m.rotary_scale) / ds * feed
+    spin = np.flatnonzero(rotation > m.max_rotation * (1 + 1e-9))
     if spin.size:
         i = int(spin[0])
         raise _limit(
-            k,
-            f"nozzle rotation {w.rotation[i]:.4g} rad/s on the move from vertex {i} exceeds "
-            f"the maximum {m.max_rotation:.4g} rad/s",
+            where,
+            f"nozzle rotation {rotation[i]:.4g} rad/s on the move from vertex {i} exceeds the "
+            f"maximum {m.max_rotation:.4g} rad/s",
             "max_rotation",
-            "slow down, spread the flip (flip_length) or raise",
+            "slow down, spread the flip over a longer flip_length (about pi*v/max_rotation "
+            "mm) or raise",
         )
-    for name, value in zip(("active", "passive"), pr, strict=True):
-        if not (math.isfinite(value) and m.min_pressure <= value <= m.max_pressure):
+
+
+def _check_process(k: int, prog: PrintProgram, proc: Process, m: MachineProfile) -> None:
+    for role, psi in proc.channels(prog.active_fraction):
+        if not (m.min_pressure <= psi <= m.max_pressure):
             raise _limit(
-                k,
-                f"{name} pressure {value:g} psi outside [{m.min_pressure:g}, "
-                f"{m.max_pressure:g}] psi",
-                "max_pressure" if value > m.min_pressure else "min_pressure",
+                f"program {k}",
+                f"{role} pressure {psi:g} psi outside [{m.min_pressure:g}, {m.max_pressure:g}] psi",
+                "max_pressure" if psi > m.max_pressure else "min_pressure",
                 "change the design's pressure or",
             )
-    if max(pr) <= 0:
-        raise InvalidParameterError(
-            "pressures", f"program {k}: both pressures are 0 psi; nothing would be extruded"
-        )
-
-
-def _pressure_line(machine: MachineProfile, port: int, psi: float) -> str:
-    if machine.dialect == "aerotech":
-        return f"Call setAlicatPress P{port} Q{_num(psi, 3)}"
-    return machine.pressure_template.format(port=port, psi=psi)
-
-
-def _dwell(machine: MachineProfile, seconds: float) -> str:
-    return f"G4 S{_num(seconds, 3)}" if machine.dialect == "marlin" else f"G4 P{_num(seconds, 3)}"
-
-
-def _travel_heights(programs: Sequence[PrintProgram], m: MachineProfile) -> list[float]:
-    """Travel height before each program and after the last (mm).
-
-    The nozzle lifts ``lift`` above the highest point printed so far (and above the start and
-    end of the travel), so a travel never crosses the part however high a filament climbed.
-    """
-    heights = []
-    top = -math.inf
-    here_z = -math.inf
-    for prog in programs:
-        pts = np.round(prog.points, _DIGITS)
-        heights.append(max(top, here_z, pts[0, 2]) + m.lift)
-        top = max(top, float(pts[:, 2].max()))
-        here_z = float(pts[-1, 2])
-    heights.append(max(top, here_z) + m.lift)
-    for k, z in enumerate(heights):
-        if z > m.envelope_max[2] + _EPS:
-            where = f"before program {k}" if k < len(programs) else "after the last program"
-            raise MachineLimitError(
-                f"travel height {z:.4g} mm {where} (lift {m.lift:g} mm above the highest point "
-                f"printed) exceeds the envelope's z maximum {m.envelope_max[2]:g} mm; lower "
-                "'lift' or raise 'envelope_max' in the machine profile"
+        if psi <= 0:
+            raise InvalidParameterError(
+                f"program {k}: {role}_pressure",
+                f"is 0 psi but active_fraction {prog.active_fraction:g} needs the {role} "
+                "channel; set a pressure > 0",
             )
-    return heights
 
 
-def _estimate_time(
-    programs: Sequence[PrintProgram], heights: list[float], m: MachineProfile, cure_s: float
-) -> float:
-    t = 0.0
-    here = None
-    for p, zt in zip(programs, heights, strict=False):
-        if here is not None:
-            flat = float(np.linalg.norm(p.points[0, :2] - here[:2]))
-            t += (flat + (zt - here[2]) + (zt - p.points[0, 2])) / m.travel_feed
-        t += p.duration
-        here = p.points[-1]
-    layers = sorted({p.layer for p in programs})
-    return t + cure_s * len(layers)
+def _travel_height(m: MachineProfile, top: float, *zs: float) -> float:
+    z = max(top, *zs) + m.lift
+    if z > m.envelope_max[2] + _EPS:
+        raise MachineLimitError(
+            f"travel height {z:.4g} mm (lift {m.lift:g} mm above the highest point printed so "
+            f"far) exceeds the envelope's z maximum {m.envelope_max[2]:g} mm; lower 'lift' or "
+            "raise 'envelope_max' in the machine profile (machine profile key 'lift')"
+        )
+    return z
 
 
-def _machine_lines(m: MachineProfile) -> list[str]:
+def _header(
+    m: MachineProfile, n: int, layers: int, design_hash: str, total: float, order: str
+) -> list[str]:
     if m.is_builtin:
         origin = (
             "built-in default (no machine profile given: its envelope and limits are "
@@ -276,21 +373,54 @@ def _machine_lines(m: MachineProfile) -> list[str]:
         )
     else:
         origin = f"profile {m.source}"
+    f_unit = "mm/s" if m.dialect == "aerotech" else "mm/min"
+    turn = "360 deg" if m.rotary_units == "deg" else "2pi rad"
+    rebase = (
+        f"re-based with G92 between filaments (restored at the end), |{m.rotary_axis}| <= {turn}"
+        if m.rotary_rebase == "g92"
+        else f"unwound while lowering to each filament, |{m.rotary_axis}| <= {turn}"
+    )
     return [
+        "; rotomorph G-code (rotational multimaterial printing)",
+        f"; tool: rotomorph {rotomorph.__version__}",
+        f"; design-sha256: {design_hash}",
         f"; machine: {m.name}, {origin}",
         f"; limits: envelope {list(m.envelope_min)}..{list(m.envelope_max)} mm, feed "
-        f"{m.min_feed:g}..{m.max_feed:g} mm/s, rotation <= {m.max_rotation:g} rad/s, pressure "
-        f"{m.min_pressure:g}..{m.max_pressure:g} psi, travel lift {m.lift:g} mm",
+        f"{m.min_feed:g}..{m.max_feed:g} mm/s, rotation <= {m.max_rotation:g} rad/s (travel "
+        f"included), pressure {m.min_pressure:g}..{m.max_pressure:g} psi, lift {m.lift:g} mm",
+        f"; dialect: {m.dialect}, pressure idiom {m.pressure_idiom}",
+        f"; units: length mm, feed {f_unit}, rotary {m.rotary_units}, pressure psi, dwell s",
+        f"; axes: {m.x_axis}=x {m.y_axis}=y {m.z_axis}=z (design z + z_offset {m.z_offset:g} "
+        "mm; Z 0 = substrate surface in the active work offset)",
+        f"; rotary: {m.rotary_axis} = nozzle angle of the active half, counter-clockwise from +x "
+        f"seen from above times sign {m.rotary_sign:+d}; must read 0 with the active half toward "
+        f"+x at the start; cumulative within a filament, {rebase}",
+        f"; pressure channels: active port {m.active_port}, passive port {m.passive_port}",
+        f"; filaments: {n}, layers: {layers}, order: {order}",
+        f"; estimated print time: {total:.1f} s",
     ]
+
+
+def plan_programs(
+    programs: Sequence[PrintProgram], machine: MachineProfile, *, serpentine: bool = True
+) -> list[PrintProgram]:
+    """The programs as :func:`gcode_text` prints them: serpentine, z offset (mm) applied."""
+    return machine_order(
+        programs,
+        serpentine=serpentine,
+        max_rotation=machine.max_rotation,
+        z_offset=machine.z_offset,
+    )
 
 
 def gcode_text(
     programs: Sequence[PrintProgram],
     machine: MachineProfile,
     *,
-    pressures: Pressure | Sequence[Pressure] = (30.0, 30.0),
+    process: Process | Sequence[Process] | None = None,
     layer_cure_s: float = 0.0,
     design_hash: str | None = None,
+    serpentine: bool = True,
 ) -> str:
     """G-code for ``programs`` on ``machine`` (pure; see module docstring for the layout).
 
@@ -299,24 +429,27 @@ def gcode_text(
     programs
         Filaments in print order; layers must not decrease.
     machine
-        The printer (required): limits, axes, dialect, pressure ports.
-    pressures
-        (active, passive) set-points in psi, one pair for all or one per program.
+        The printer: limits, axes, dialect, pressure idiom.
+    process
+        Pressures and dwells, one :class:`Process` for all or one per program (default
+        :class:`Process`: 30 psi on each channel used, no dwells).
     layer_cure_s
-        UV-cure dwell after each layer (s); 0 writes none (paper: cure after each layer).
+        UV-cure dwell after each layer (s); 0 writes none.
     design_hash
         sha256 to record in the header; default :func:`programs_sha256` of ``programs``.
+    serpentine
+        Print a program backward when that avoids a return travel (:func:`plan_programs`).
 
     Raises
     ------
     MachineLimitError
-        Envelope (travel included), feed (minimum and maximum), rotation or pressure limit
-        exceeded; the message names the machine-profile key (nothing is produced).
+        Envelope (travel included), feed (minimum and maximum), rotation (travel included) or
+        pressure limit exceeded; the message names the machine-profile key.
     MaterialError
         A material that ``rotomorph validate`` would refuse.
     InvalidParameterError
-        No programs, decreasing layers, bad pressures or cure time, a name that is not one word
-        of printable ASCII.
+        No programs, decreasing layers, bad process settings or cure time, a name that is not
+        one word of printable ASCII.
     """
     if len(programs) == 0:
         raise InvalidParameterError("programs", "needs at least one PrintProgram")
@@ -328,81 +461,114 @@ def gcode_text(
     if design_hash is not None and not re.fullmatch(r"[0-9a-f]{64}", design_hash):
         raise InvalidParameterError("design_hash", "must be a sha256 hex digest (64 characters)")
     check_materials(programs)
-    press = _pressures(pressures, len(programs))
+    procs = _as_process(Process() if process is None else process, len(programs))
     m = machine
-    written = [_written(p, m, float(p.nozzle_angle[0])) for p in programs]
-    for k, (prog, w, pr) in enumerate(zip(programs, written, press, strict=True)):
-        _check_program(k, prog, w, pr, m)
-    heights = _travel_heights(programs, m)
-    X, Y, Z, A = m.x_axis, m.y_axis, m.z_axis, m.rotary_axis
-    f_unit = "mm/s" if m.dialect == "aerotech" else "mm/min"
-    total = _estimate_time(programs, heights, m, layer_cure_s)
-    out = [
-        "; rotomorph G-code (rotational multimaterial printing)",
-        f"; tool: rotomorph {rotomorph.__version__}",
-        f"; design-sha256: {design_hash or programs_sha256(programs)}",
-        *_machine_lines(m),
-        f"; dialect: {m.dialect}",
-        f"; units: length mm, feed {f_unit}, rotary {m.rotary_units}, pressure psi",
-        f"; axes: {X}=x {Y}=y {Z}=z {A}=nozzle angle (sign {m.rotary_sign:+d}, ccw from +x seen "
-        "from above), cumulative",
-        f"; pressure channels: active port {m.active_port}, passive port {m.passive_port}",
-        f"; filaments: {len(programs)}, layers: {len(set(layers))}",
-        f"; estimated print time: {total:.1f} s",
-    ]
-    out += ["G71", "G76", "G90"] if m.dialect == "aerotech" else ["G21", "G90"]
-    fs = m.feed_scale
-    current_layer = None
-    for k, (prog, w, (pa, pp)) in enumerate(zip(programs, written, press, strict=True)):
+    printed = plan_programs(programs, m, serpentine=serpentine)
+    for k, (prog, proc) in enumerate(zip(printed, procs, strict=True)):
+        _check_process(k, prog, proc, m)
+
+    w = _Writer(m)
+    top = -math.inf
+    current_layer: int | None = None
+    for k, (prog, proc) in enumerate(zip(printed, procs, strict=True)):
+        pts = np.round(prog.points, _DIGITS)
+        start = _start_word(w, prog, m)
+        words = _written_angles(prog, pts, start, m.rotary_scale)
+        _check_program(k, prog, pts, words, m)
+        zt = _travel_height(m, top, pts[0, 2], *([] if w.xyz is None else [w.xyz[2]]))
         if prog.layer != current_layer:
             if current_layer is not None and layer_cure_s > 0:
-                out += _cure(m, current_layer, layer_cure_s)
+                w.rapid(np.array([*w.xyz[:2], zt]), "z")  # type: ignore[index]
+                _cure(w, current_layer, layer_cure_s)
             current_layer = prog.layer
-            out.append(f"; layer {prog.layer}")
-        pts, ang = w.points, w.angle
-        out.append(
+            w.emit(f"; layer {prog.layer}")
+        w.emit(
             f"; filament {k} layer={prog.layer} radius={prog.radius!r} "
             f"active_fraction={prog.active_fraction!r} active_material={prog.active_material} "
             f"passive_material={prog.passive_material}"
         )
-        x0, y0, z0 = pts[0]
-        out += [
-            f"G0 {Z}{_num(heights[k])}",
-            f"G0 {X}{_num(x0)} {Y}{_num(y0)} {A}{_num(ang[0])}",
-            f"G0 {Z}{_num(z0)}",
-            _pressure_line(m, m.active_port, pa),
-            _pressure_line(m, m.passive_port, pp),
-        ]
-        zc = z0
+        _travel(w, k, pts[0], zt, start)
+        for role, psi in proc.channels(prog.active_fraction):
+            w.emit(*pressure_lines(m, getattr(m, f"{role}_port"), psi, True))
+        w.dwell(proc.prime_dwell)
         for i in range(1, len(pts)):
-            x, y, z = pts[i]
-            zword = f" {Z}{_num(z)}" if _num(z) != _num(zc) else ""
-            zc = z
-            out.append(
-                f"G1 {X}{_num(x)} {Y}{_num(y)}{zword} {A}{_num(ang[i])} "
-                f"F{_feed(w.feed[i - 1] * fs)}"
-            )
-        out += [
-            _pressure_line(m, m.active_port, 0.0),
-            _pressure_line(m, m.passive_port, 0.0),
-            f"; end filament {k}",
-        ]
+            axes = "xyz" if _num(pts[i, 2]) != _num(pts[i - 1, 2]) else "xy"
+            w.linear(pts[i], float(words[i]), float(prog.speed[i - 1]), axes)
+        for role, psi in proc.channels(prog.active_fraction):
+            w.emit(*pressure_lines(m, getattr(m, f"{role}_port"), psi, False))
+        w.dwell(proc.release_dwell)
+        w.emit(f"; end filament {k}")
+        top = max(top, float(pts[:, 2].max()))
+    assert w.xyz is not None
+    w.rapid(np.array([*w.xyz[:2], _travel_height(m, top, w.xyz[2])]), "z")
     if layer_cure_s > 0:
-        out += _cure(m, current_layer, layer_cure_s)
-    out.append(f"G0 {Z}{_num(heights[-1])}")
-    if m.dialect != "marlin":
-        out.append("M2")
-    text = "\n".join(out) + "\n"
-    assert all(32 <= ord(c) < 127 for c in text.replace("\n", ""))
+        _cure(w, current_layer, layer_cure_s)
+    if w.shift != 0.0:
+        w.emit(f"G92 {m.rotary_axis}{_num(w.angle + w.shift)}")
+    w.emit(*(m.end_lines or ()), *m.footer_lines)
+    order = "serpentine" if serpentine else "as designed"
+    head = _header(
+        m,
+        len(printed),
+        len(set(layers)),
+        design_hash or programs_sha256(programs),
+        w.time,
+        order,
+    )
+    text = "\n".join([*head, *m.header_lines, *(m.setup_lines or ()), *w.lines]) + "\n"
+    if re.search(r"[^\x20-\x7e\n]", text):  # pragma: no cover - every input is checked
+        raise AssertionError("non-printable character in the program")
     return text
 
 
-def _cure(m: MachineProfile, layer: int | None, seconds: float) -> list[str]:
-    lines = [f"; UV cure after layer {layer}: {seconds:g} s"]
-    lines += [m.uv_on_template] if m.uv_on_template else []
-    lines.append(_dwell(m, seconds))
-    lines += [m.uv_off_template] if m.uv_off_template else []
-    return lines
+def _start_word(w: _Writer, prog: PrintProgram, m: MachineProfile) -> float:
+    """Rotary word of the filament's first vertex: the design angle + whole turns, near now."""
+    first = float(prog.nozzle_angle[0]) * m.rotary_scale
+    if m.rotary_rebase == "g92":
+        here = w.angle - m.turn * round(w.angle / m.turn)  # what G92 re-bases to
+    else:
+        here = 0.0
+    return float(np.round(first + m.turn * round((here - first) / m.turn), _DIGITS))
+
+
+def _travel(w: _Writer, k: int, start: np.ndarray, zt: float, angle: float) -> None:
+    """Lift, travel at ``zt``, re-base the rotary word, lower to ``start`` turning to ``angle``."""
+    m = w.m
+    if w.xyz is None:  # where the machine starts is unknown: go up first
+        w.xyz = np.full(3, np.nan)
+    w.rapid(np.array([w.xyz[0], w.xyz[1], zt]), "z")
+    w.rapid(np.array([start[0], start[1], zt]), "xy")
+    if m.rotary_rebase == "g92" and abs(w.angle) > m.turn / 2:
+        rebased = float(np.round(w.angle - m.turn * round(w.angle / m.turn), _DIGITS))
+        w.emit(f"G92 {m.rotary_axis}{_num(rebased)}")
+        w.shift += w.angle - rebased
+        w.angle = rebased
+    drop = zt - float(start[2])
+    turn = abs(angle - w.angle) / abs(m.rotary_scale)  # rad
+    feed = m.travel_feed
+    if turn * feed > m.max_rotation * drop:  # turning limits the lowering feed: 4 digits, down
+        exact = m.max_rotation * drop / turn
+        step = 10.0 ** (math.floor(math.log10(exact)) - 3)
+        feed = math.floor(exact / step) * step
+    if feed < m.min_feed:
+        raise _limit(
+            f"program {k}",
+            f"unwinding {turn / (2 * math.pi):.1f} turns while lowering {drop:.3g} mm needs a "
+            f"feed of {feed:.3g} mm/s, below the minimum",
+            "rotary_rebase",
+            "re-base instead (rotary_rebase = 'g92') or check",
+        )
+    w.linear(np.array(start, dtype=float), angle, feed, "z")
+
+
+def _cure(w: _Writer, layer: int | None, seconds: float) -> None:
+    m = w.m
+    w.emit(f"; UV cure after layer {layer}: {seconds:g} s")
+    if m.uv_on_template:
+        w.emit(m.uv_on_template)
+    w.dwell(seconds)
+    if m.uv_off_template:
+        w.emit(m.uv_off_template)
 
 
 def write_gcode(
@@ -410,15 +576,21 @@ def write_gcode(
     path: str | FilePath,
     machine: MachineProfile,
     *,
-    pressures: Pressure | Sequence[Pressure] = (30.0, 30.0),
+    process: Process | Sequence[Process] | None = None,
     layer_cure_s: float = 0.0,
     design_hash: str | None = None,
+    serpentine: bool = True,
 ) -> FilePath:
     """Write :func:`gcode_text` to ``path`` atomically and return the path.
 
     Nothing is written (not even a temporary file) if a limit is exceeded.
     """
     text = gcode_text(
-        programs, machine, pressures=pressures, layer_cure_s=layer_cure_s, design_hash=design_hash
+        programs,
+        machine,
+        process=process,
+        layer_cure_s=layer_cure_s,
+        design_hash=design_hash,
+        serpentine=serpentine,
     )
     return atomic_write_text(path, text)

@@ -1,17 +1,36 @@
-"""Machine profiles for the G-code writer: envelope, limits, axis letters, dialect, ports.
+"""Machine profiles for the G-code writer: envelope, limits, axes, dialect, pressure idiom.
 
-The writer refuses (raises :class:`~rotomorph.errors.MachineLimitError`) any toolpath that leaves
-the envelope or exceeds a limit, so a profile is a required argument: there is no safe default
-machine. Dialects (DESIGN.md section 7):
+A profile is what a lab writes once per printer (a TOML file with a ``[machine]`` table, see
+``examples/machines/``); the writer refuses (:class:`~rotomorph.errors.MachineLimitError`) any
+program that would leave its envelope or exceed one of its limits, naming the key to change.
 
+Dialects
+--------
 ``aerotech``
-    mecode-compatible: ``G71`` (metric), ``G76`` (time in seconds), ``G90``; F in mm/s;
-    pressures as ``Call setAlicatPress P<com> Q<psi>``; dwell ``G4 P<s>``.
+    Aerotech A3200 as mecode writes it: setup ``G71`` (metric) ``G76`` (seconds) ``G90``;
+    F in mm/s on its own ``G1 F<v>`` line whenever the speed changes (mecode's ``feed``);
+    moves ``G1 X Y [Z] C`` (mecode's ``move(x=, y=, C=)``); dwell ``G4 P<s>``; pressure
+    idiom ``alicat`` (``Call setAlicatPress P<com> Q<psi>``, off = ``Q0``) or ``nordson``
+    (``Call setPress P<com> Q<psi>`` then ``Call togglePress P<com>``; off = a second toggle);
+    optional A3200 header and footer files (DVAR declarations, the ``DFS setPress`` subroutines).
 ``rs274``
-    ``G21``/``G90``; F in mm/min; pressures from :attr:`MachineProfile.pressure_template`;
-    dwell ``G4 P<s>`` (RS274/NGC seconds).
+    LinuxCNC / RS-274/NGC: ``G21 G90 G94``; F in mm/min on every print move; rapid ``G0``
+    travel; dwell ``G4 P<s>`` (seconds); pressure from templates, by default an analog output
+    for the set-point (``M68 E{port} Q{psi}``) and digital outputs for the valves
+    (``M64 P{port}`` on, ``M65 P{port}`` off); ``M2`` at the end.
 ``marlin``
-    as ``rs274`` but dwell ``G4 S<s>`` and no ``M2`` at the end.
+    Marlin, Klipper and RepRapFirmware: ``G21 G90``; F in mm/min on *every* move, travel
+    included (``G0`` is ``G1`` on these firmwares); dwell ``G4 P<ms>`` (milliseconds, which all
+    three read the same way); pressure from templates (``M42``, ``SET_PIN`` or macros).
+
+Rotary axis
+-----------
+The nozzle angle α_n (rad, counter-clockwise from +x seen from above) is written on
+``rotary_axis`` (default ``C``: rotation about Z in RS-274/ISO; ``A`` is rotation about X, and in
+many mecode labs a second Z stage), in ``rotary_units`` and with ``rotary_sign``. The program
+assumes the axis reads 0 with the active half toward +x at the start. Between filaments the
+angle is re-based (``rotary_rebase = "g92"``: ``G92 C<angle mod 360>``, restored at the end) or
+unwound (``"unwind"``), so it never exceeds one turn between filaments.
 """
 
 from __future__ import annotations
@@ -26,10 +45,51 @@ from typing import Any
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.tomlfile import read_toml
 
-__all__ = ["DIALECTS", "MachineProfile", "check_line", "load_machine_profile"]
+__all__ = [
+    "DIALECTS",
+    "PRESSURE_IDIOMS",
+    "MachineProfile",
+    "check_line",
+    "fill_template",
+    "load_machine_profile",
+]
 
 DIALECTS = ("aerotech", "rs274", "marlin")
+PRESSURE_IDIOMS = ("alicat", "nordson", "template")
 BUILTIN = "built-in default"
+
+#: Dialect defaults of the keys left unset (``None``) in a profile.
+_DEFAULTS: dict[str, dict[str, Any]] = {
+    "aerotech": {
+        "pressure_idiom": "alicat",
+        "pressure_template": "",
+        "valve_on_template": "",
+        "valve_off_template": "",
+        "dwell_template": "G4 P{s}",
+        "setup_lines": ("G71", "G76", "G90"),
+        "end_lines": ("M2",),
+    },
+    "rs274": {
+        "pressure_idiom": "template",
+        "pressure_template": "M68 E{port} Q{psi:.3f}",
+        "valve_on_template": "M64 P{port}",
+        "valve_off_template": "M65 P{port}",
+        "dwell_template": "G4 P{s}",
+        "setup_lines": ("G21", "G90", "G94"),
+        "end_lines": ("M2",),
+    },
+    "marlin": {
+        "pressure_idiom": "template",
+        "pressure_template": "M42 P{port} S{pwm}",
+        "valve_on_template": "",
+        "valve_off_template": "",
+        "dwell_template": "G4 P{ms}",
+        "setup_lines": ("G21", "G90"),
+        "end_lines": (),
+    },
+}
+_PRESSURE_FIELDS = {"psi", "fraction", "pwm"}
+_RESERVED = {"F", "G", "M", "N", "P", "Q", "S", "E", "T", "O"}
 
 
 def _bad(field: str, message: str) -> InvalidParameterError:
@@ -41,8 +101,8 @@ def check_line(field: str, text: object, *, token: bool = False) -> str:
     """``text`` if it is one line of printable ASCII, else raise naming ``field``.
 
     Everything that a design or a machine profile contributes to a G-code program (names,
-    templates, comments) passes through here, so no newline, carriage return, NUL or other
-    control character can start a new block in the program.
+    templates, comments, header lines) passes through here, so no newline, carriage return,
+    NUL or other control character can start a new block in the program.
 
     Parameters
     ----------
@@ -65,51 +125,77 @@ def check_line(field: str, text: object, *, token: bool = False) -> str:
     return text
 
 
+def _fields(template: str) -> set[str]:
+    return {f[1] for f in string.Formatter().parse(template) if f[1] is not None}
+
+
+def fill_template(template: str, **values: float) -> str:
+    """``template.format(**values)`` with only the fields the template names (psi, port, …)."""
+    return template.format(**{k: v for k, v in values.items() if k in _fields(template)})
+
+
 @dataclass(frozen=True)
 class MachineProfile:
     """A printer: where it can go, how fast, and how its G-code is spelled.
 
+    Every key below is a key of the ``[machine]`` table of a profile file; ``None`` means the
+    dialect's default (module docstring). Errors name the key to change.
+
     Parameters
     ----------
     name
-        Free label, written in the G-code header.
+        Label written in the G-code header (one line of printable ASCII).
     dialect
         ``"aerotech"``, ``"rs274"`` or ``"marlin"`` (module docstring).
     envelope_min, envelope_max
-        Work envelope corners (x, y, z) in mm; every vertex and travel move must lie inside.
-    max_feed
-        Highest print feed (mm/s).
+        Work envelope corners (x, y, z) in mm, in program coordinates (after ``z_offset``);
+        every vertex and travel move must lie inside.
+    max_feed, min_feed
+        Print feed range (mm/s); slower or faster print moves are refused.
     travel_feed
-        Feed used to estimate travel time (mm/s); travel is written as rapid ``G0`` moves.
+        Feed of travel and lift moves (mm/s); written on every travel in ``marlin``, used for
+        the time estimate of rapid ``G0`` moves elsewhere.
     max_rotation
-        Highest nozzle rotation rate on a print move (rad/s).
+        Highest nozzle rotation rate (rad/s) on any move, travel included (a file may give
+        ``max_rotation_deg_s`` instead, in deg/s).
     max_pressure, min_pressure
-        Pressure set-point limits (psi); the Alicat PCD-100PSIG of the paper: 0..100 psi.
+        Pressure set-point limits (psi); the regulator's full scale for ``{fraction}``/``{pwm}``.
     active_port, passive_port
-        COM ports (aerotech) or template ports of the active and passive pressure channels.
+        COM port (aerotech) or output index (templates) of the active and passive channels.
     x_axis, y_axis, z_axis, rotary_axis
-        Axis letters. RS-274 names rotation about Z ``C``; many dispensing rigs use ``A`` for
-        the rotary nozzle (default) but check that ``A`` is not a second Z stage on yours.
+        Axis letters; the rotary default ``C`` is rotation about Z (RS-274/ISO).
     rotary_units
-        ``"deg"`` (default) or ``"rad"`` for the rotary axis words.
+        ``"deg"`` (default) or ``"rad"`` for the rotary words.
     rotary_sign
-        +1 if a positive rotary command turns the nozzle counter-clockwise seen from above
-        (the nozzle-angle sense), -1 otherwise.
+        +1 if a positive rotary command turns the nozzle counter-clockwise seen from above.
+    rotary_rebase
+        ``"g92"`` (re-base the angle word with ``G92`` between filaments) or ``"unwind"``
+        (turn back during the lowering move; slow after long rotating filaments).
     lift
-        Travel height above the current layer (mm), > 0.
+        Travel clearance above the highest point printed so far (mm), > 0.
+    z_offset
+        Added to every design z (mm): program Z of the nozzle tip at design z = 0 (the
+        substrate), so layers sit at ``z_offset + k * layer_height``.
+    pressure_idiom
+        ``"alicat"`` or ``"nordson"`` (aerotech), ``"template"`` (any dialect).
     pressure_template
-        rs274/marlin pressure line with fields ``{port}`` and ``{psi}`` (a format spec on
-        ``psi`` is allowed, e.g. ``{psi:.3f}``); map it to your controller's macro.
+        Set-point line with fields ``{port}`` and one of ``{psi}``, ``{fraction}``
+        (psi / max_pressure) or ``{pwm}`` (0–255 of max_pressure); format specs allowed.
+    valve_on_template, valve_off_template
+        Optional lines (field ``{port}``) that open and close a channel; without them a
+        channel is turned off by setting it to 0.
+    dwell_template
+        Dwell line with field ``{s}`` (seconds) or ``{ms}`` (milliseconds).
     uv_on_template, uv_off_template
-        Optional lines around the per-layer UV-cure dwell (empty: dwell only).
-    min_feed
-        Lowest print feed (mm/s) the controller executes faithfully; slower moves are refused.
+        Optional lines around the per-layer UV-cure dwell.
+    setup_lines, end_lines
+        Lines after the header comment and at the end of the program.
+    header_lines, footer_lines
+        Verbatim lines before the setup and after the end (a file may give ``header_file``
+        and ``footer_file``, read relative to the profile; tabs become spaces).
     source
         Where the profile came from: the file name, or ``"built-in default"`` (stated in the
         G-code header). Not a file key.
-
-    Every text value must be one line of printable ASCII (:func:`check_line`); errors name the
-    key of the profile file to change.
     """
 
     name: str = "generic"
@@ -127,13 +213,23 @@ class MachineProfile:
     x_axis: str = "X"
     y_axis: str = "Y"
     z_axis: str = "Z"
-    rotary_axis: str = "A"
+    rotary_axis: str = "C"
     rotary_units: str = "deg"
     rotary_sign: int = 1
+    rotary_rebase: str = "g92"
     lift: float = 2.0
-    pressure_template: str = "M800 P{port} Q{psi:.3f}"
+    z_offset: float = 0.0
+    pressure_idiom: str | None = None
+    pressure_template: str | None = None
+    valve_on_template: str | None = None
+    valve_off_template: str | None = None
+    dwell_template: str | None = None
     uv_on_template: str = ""
     uv_off_template: str = ""
+    setup_lines: tuple[str, ...] | None = None
+    end_lines: tuple[str, ...] | None = None
+    header_lines: tuple[str, ...] = ()
+    footer_lines: tuple[str, ...] = ()
     source: str = BUILTIN
 
     def __post_init__(self) -> None:
@@ -141,70 +237,110 @@ class MachineProfile:
         check_line("machine profile source", self.source)
         if self.dialect not in DIALECTS:
             raise _bad("dialect", f"must be one of {DIALECTS}; got {self.dialect!r}")
-        lo = tuple(float(v) for v in self.envelope_min)
-        hi = tuple(float(v) for v in self.envelope_max)
+        for key, value in _DEFAULTS[self.dialect].items():
+            if getattr(self, key) is None:
+                object.__setattr__(self, key, value)
+        self._check_numbers()
+        self._check_axes()
+        self._check_text()
+
+    def _check_numbers(self) -> None:
+        try:
+            lo = tuple(float(v) for v in self.envelope_min)
+            hi = tuple(float(v) for v in self.envelope_max)
+        except (TypeError, ValueError):
+            raise _bad("envelope_max", "corners must be three numbers [x, y, z] (mm)") from None
         if not all(math.isfinite(v) for v in lo + hi):
             raise _bad("envelope_max", f"corners must be finite (mm); got {lo} .. {hi}")
         if len(lo) != 3 or len(hi) != 3 or not all(a < b for a, b in zip(lo, hi, strict=False)):
             raise _bad("envelope_max", f"must exceed envelope_min on x, y, z; got {lo} .. {hi}")
         object.__setattr__(self, "envelope_min", lo)
         object.__setattr__(self, "envelope_max", hi)
-        for name in (
-            "max_feed",
-            "min_feed",
-            "travel_feed",
-            "max_rotation",
-            "max_pressure",
-            "lift",
-        ):
+        for name in ("max_feed", "min_feed", "travel_feed", "max_rotation", "max_pressure", "lift"):
             v = getattr(self, name)
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, int | float)
-                or not (math.isfinite(v) and v > 0)
-            ):
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
                 raise _bad(name, f"must be a finite number > 0; got {v!r}")
+            if v <= 0:
+                raise _bad(name, f"must be a finite number > 0; got {v!r}")
+        for name in ("min_pressure", "z_offset"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise _bad(name, f"must be a finite number; got {v!r}")
         if not self.min_feed < self.max_feed:
-            raise _bad(
-                "min_feed", f"must be < max_feed ({self.max_feed} mm/s); got {self.min_feed}"
-            )
+            raise _bad("min_feed", f"must be < max_feed {self.max_feed} mm/s; got {self.min_feed}")
         if not self.min_feed <= self.travel_feed:
             raise _bad("travel_feed", f"must be >= min_feed ({self.min_feed} mm/s)")
-        if not (math.isfinite(self.min_pressure) and 0 <= self.min_pressure < self.max_pressure):
+        if not 0 <= self.min_pressure < self.max_pressure:
             raise _bad("min_pressure", f"must lie in [0, max_pressure); got {self.min_pressure}")
-        letters = [self.x_axis, self.y_axis, self.z_axis, self.rotary_axis]
-        if any(not isinstance(a, str) or len(a) != 1 or not ("A" <= a <= "Z") for a in letters):
-            raise _bad("rotary_axis", f"axis letters must be single capitals; got {letters}")
-        if len(set(letters)) != 4 or set(letters) & {"F", "G", "M", "P", "Q", "S", "N"}:
-            raise _bad(
-                "rotary_axis", f"axis letters must be distinct, not F/G/M/N/P/Q/S; got {letters}"
-            )
-        if self.rotary_units not in ("deg", "rad"):
-            raise _bad("rotary_units", f"must be 'deg' or 'rad'; got {self.rotary_units!r}")
-        if self.rotary_sign not in (1, -1):
-            raise _bad("rotary_sign", f"must be +1 or -1; got {self.rotary_sign}")
         for name in ("active_port", "passive_port"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 9999:
                 raise _bad(name, f"must be an integer in [0, 9999]; got {v!r}")
         if self.active_port == self.passive_port:
             raise _bad("passive_port", "must differ from active_port")
-        for name in ("pressure_template", "uv_on_template", "uv_off_template"):
-            check_line(f"machine profile key '{name}'", getattr(self, name))
-        try:
-            names = {f[1] for f in string.Formatter().parse(self.pressure_template) if f[1]}
-            self.pressure_template.format(port=1, psi=1.0)
-        except (ValueError, KeyError, IndexError, AttributeError) as err:
-            raise _bad(
-                "pressure_template",
-                f"is not a valid template ({err}); write e.g. 'M800 P{{port}} Q{{psi:.3f}}'",
-            ) from None
-        if names != {"port", "psi"}:
-            raise _bad("pressure_template", f"must use exactly {{port}} and {{psi}}; got {names}")
-        for name in ("uv_on_template", "uv_off_template"):
-            if any(f[1] is not None for f in string.Formatter().parse(getattr(self, name))):
-                raise _bad(name, "takes no {fields}; write the line literally")
 
+    def _check_axes(self) -> None:
+        letters = [self.x_axis, self.y_axis, self.z_axis, self.rotary_axis]
+        names = ("x_axis", "y_axis", "z_axis", "rotary_axis")
+        for key, a in zip(names, letters, strict=True):
+            if not isinstance(a, str) or len(a) != 1 or not "A" <= a <= "Z" or a in _RESERVED:
+                raise _bad(key, f"must be one capital letter, not {sorted(_RESERVED)}; got {a!r}")
+        if len(set(letters)) != 4:
+            raise _bad("rotary_axis", f"axis letters must be distinct; got {letters}")
+        if self.rotary_units not in ("deg", "rad"):
+            raise _bad("rotary_units", f"must be 'deg' or 'rad'; got {self.rotary_units!r}")
+        if self.rotary_sign not in (1, -1) or isinstance(self.rotary_sign, bool):
+            raise _bad("rotary_sign", f"must be +1 or -1; got {self.rotary_sign!r}")
+        if self.rotary_rebase not in ("g92", "unwind"):
+            raise _bad("rotary_rebase", f"must be 'g92' or 'unwind'; got {self.rotary_rebase!r}")
+
+    def _check_text(self) -> None:
+        if self.pressure_idiom not in PRESSURE_IDIOMS:
+            raise _bad("pressure_idiom", f"must be one of {PRESSURE_IDIOMS}")
+        if self.pressure_idiom != "template" and self.dialect != "aerotech":
+            raise _bad("pressure_idiom", "'alicat' and 'nordson' are Aerotech subroutine calls")
+        templates: dict[str, set[str]] = {
+            "pressure_template": {"port"} | _PRESSURE_FIELDS,
+            "valve_on_template": {"port"},
+            "valve_off_template": {"port"},
+            "dwell_template": {"s", "ms"},
+            "uv_on_template": set(),
+            "uv_off_template": set(),
+        }
+        sample = {"port": 5, "psi": 1.5, "fraction": 0.5, "pwm": 128, "s": 1.5, "ms": 1500}
+        for key, allowed in templates.items():
+            text = check_line(f"machine profile key '{key}'", getattr(self, key))
+            try:
+                used = _fields(text)
+                fill_template(text, **sample)
+            except (ValueError, IndexError, KeyError) as exc:
+                raise _bad(key, f"is not a valid template ({exc}); got {text!r}") from None
+            if not used <= allowed:
+                raise _bad(key, f"may only use fields {sorted(allowed)}; got {sorted(used)}")
+        if self.pressure_idiom == "template":
+            if not self.pressure_template and not self.valve_on_template:
+                raise _bad("pressure_template", "give a set-point or valve template")
+            if (
+                self.pressure_template
+                and len(_fields(self.pressure_template) & _PRESSURE_FIELDS) != 1
+            ):
+                raise _bad("pressure_template", "must use exactly one of {psi}, {fraction}, {pwm}")
+            if bool(self.valve_on_template) != bool(self.valve_off_template):
+                raise _bad("valve_off_template", "give both valve templates or neither")
+            if self.valve_on_template and self.valve_on_template == self.valve_off_template:
+                raise _bad("valve_off_template", "must differ from valve_on_template")
+        dwell = _fields(self.dwell_template or "")
+        if len(dwell) != 1:
+            raise _bad("dwell_template", "must use exactly one of {s} or {ms}")
+        for key in ("setup_lines", "end_lines", "header_lines", "footer_lines"):
+            lines = getattr(self, key)
+            if isinstance(lines, str) or not isinstance(lines, tuple | list):
+                raise _bad(key, "must be a list of lines")
+            for i, line in enumerate(lines):
+                check_line(f"machine profile key '{key}' line {i + 1}", line)
+            object.__setattr__(self, key, tuple(line.rstrip() for line in lines))
+
+    # ------------------------------------------------------------------ derived
     @property
     def is_builtin(self) -> bool:
         """True for the built-in default profile (no profile file was given)."""
@@ -220,9 +356,26 @@ class MachineProfile:
         """Factor from nozzle angle (rad) to the rotary axis word (deg or rad, with sign)."""
         return self.rotary_sign * (180.0 / math.pi if self.rotary_units == "deg" else 1.0)
 
+    @property
+    def turn(self) -> float:
+        """One full turn in rotary-word units (360 or 2π)."""
+        return 360.0 if self.rotary_units == "deg" else 2 * math.pi
+
+    def pressure_values(self, psi: float) -> dict[str, float]:
+        """Template values for a set-point of ``psi``: psi, fraction and pwm (0–255)."""
+        fraction = psi / self.max_pressure
+        return {"psi": psi, "fraction": fraction, "pwm": round(255 * fraction)}
+
+    # ------------------------------------------------------------------ files
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> MachineProfile:
-        """Profile from a mapping; ``max_rotation_deg_s`` (deg/s) may replace ``max_rotation``."""
+    def from_dict(
+        cls, data: Mapping[str, Any], *, folder: FilePath | None = None
+    ) -> MachineProfile:
+        """Profile from a mapping (a ``[machine]`` table).
+
+        ``max_rotation_deg_s`` (deg/s) may replace ``max_rotation``; ``header_file`` and
+        ``footer_file`` name text files (relative to ``folder``) for the verbatim lines.
+        """
         data = dict(data)
         if "max_rotation_deg_s" in data:
             if "max_rotation" in data:
@@ -231,25 +384,44 @@ class MachineProfile:
             if isinstance(deg, bool) or not isinstance(deg, int | float):
                 raise _bad("max_rotation_deg_s", f"must be a number (deg/s); got {deg!r}")
             data["max_rotation"] = math.radians(deg)
+        for key in ("header", "footer"):
+            if f"{key}_file" in data:
+                if f"{key}_lines" in data:
+                    raise _bad(f"{key}_file", f"give {key}_file or {key}_lines, not both")
+                data[f"{key}_lines"] = _read_lines(f"{key}_file", data.pop(f"{key}_file"), folder)
         known = {f.name for f in fields(cls)} - {"source"}
         unknown = sorted(set(data) - known)
         if unknown:
             raise _bad(unknown[0], f"unknown setting; known: {sorted(known)}")
-        for k in ("envelope_min", "envelope_max"):
-            if k in data:
-                v = data[k]
+        for k, v in data.items():
+            default = getattr(cls, k, None)
+            if k in ("envelope_min", "envelope_max"):
                 if not isinstance(v, list | tuple) or not all(
                     isinstance(c, int | float) and not isinstance(c, bool) for c in v
                 ):
                     raise _bad(k, f"must be three numbers [x, y, z] (mm); got {v!r}")
                 data[k] = tuple(v)
-        for k, v in data.items():
-            expect = (str,) if isinstance(getattr(cls, k, None), str) else (int, float)
-            if isinstance(getattr(cls, k, None), tuple):
-                continue
-            if isinstance(v, bool) or not isinstance(v, expect):
-                raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r}")
+            elif k.endswith("_lines"):
+                if not isinstance(v, list | tuple) or not all(isinstance(c, str) for c in v):
+                    raise _bad(k, f"must be a list of strings; got {v!r}")
+                data[k] = tuple(v)
+            elif k.endswith(("_template", "_idiom")) or isinstance(default, str):
+                if not isinstance(v, str):
+                    raise _bad(k, f"must be a string; got {v!r}")
+            elif isinstance(v, bool) or not isinstance(v, int | float):
+                raise _bad(k, f"must be a number; got {v!r}")
         return cls(**data)
+
+
+def _read_lines(key: str, value: object, folder: FilePath | None) -> tuple[str, ...]:
+    if not isinstance(value, str) or not value:
+        raise _bad(key, f"must be a file name; got {value!r}")
+    path = FilePath(value) if folder is None else folder / value
+    try:
+        text = path.read_text(encoding="ascii")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _bad(key, f"cannot read {value!r} as an ASCII text file ({exc})") from None
+    return tuple(line.expandtabs(4).rstrip() for line in text.splitlines())
 
 
 def load_machine_profile(path: str | FilePath) -> MachineProfile:
@@ -261,9 +433,10 @@ def load_machine_profile(path: str | FilePath) -> MachineProfile:
         Not UTF-8 (or UTF-16/32 with a BOM), not valid TOML, unknown keys, wrong types or
         values out of range (one line naming the key).
     """
+    path = FilePath(path)
     data = read_toml(path)
     table = data.get("machine", data)
     if not isinstance(table, dict):
         raise _bad("machine", f"must be a table [machine]; got {table!r}")
-    profile = MachineProfile.from_dict(table)
-    return replace(profile, source=check_line("machine profile path", FilePath(path).name))
+    profile = MachineProfile.from_dict(table, folder=path.parent)
+    return replace(profile, source=check_line("machine profile path", path.name))
