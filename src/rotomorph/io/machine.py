@@ -407,9 +407,9 @@ class MachineProfile:
                 data[k] = tuple(v)
             elif k.endswith(("_template", "_idiom")) or isinstance(default, str):
                 if not isinstance(v, str):
-                    raise _bad(k, f"must be a string; got {v!r}")
+                    raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r}")
             elif isinstance(v, bool) or not isinstance(v, int | float):
-                raise _bad(k, f"must be a number; got {v!r}")
+                raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r} (give a number)")
         return cls(**data)
 
 
