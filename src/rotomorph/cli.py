@@ -3,7 +3,8 @@
 Commands::
 
     rotomorph validate DESIGN.toml            check a design file (or --schema: print the schema)
-    rotomorph gcode DESIGN.toml -o FILE --dialect aerotech|rs274|marlin [--machine PROFILE.toml]
+    rotomorph gcode DESIGN.toml -o FILE [--machine PROFILE.toml] [--preview]   machine code
+    rotomorph gcode --check FILE --machine PROFILE.toml    read a program back and check it
     rotomorph simulate DESIGN.toml -o OUT/    predicted shapes over heating (HDF5, figures, …)
     rotomorph plot RESULT.h5 -o DIR           figures and movie from a results file
     rotomorph view RUN [-o FILE.html]         interactive 3-D viewer of a run (needs plotly)

@@ -26,7 +26,9 @@ driven by at most one of ``rotation`` (ω, rad/s), ``rotation_number`` (ω*) or
 ``interface_angle_deg`` (α held constant, nozzle tracks the heading); a filament-level
 ``active_side = "outer" | "inner"`` keeps the active half on one side of the curvature
 (notes Q6), with ``flip_length`` (mm) spreading each π flip. Angles in files are in degrees
-(``*_deg``), everything else in mm, s, rad/s, psi.
+(``*_deg``), everything else in mm, s, rad/s, psi. Process settings for G-code
+(``active_pressure``, ``passive_pressure`` in psi, ``prime_dwell``, ``release_dwell`` in s) sit
+in ``[nozzle]`` and may be overridden per filament or for the lattice (``docs/gcode.md``).
 
 Errors name the field path and the fix, e.g.
 ``filaments[0].segments[2].speed: must be > 0 mm/s; got -2``, raised as

@@ -330,8 +330,9 @@ def _check_program(
             f"nozzle rotation {rotation[i]:.4g} rad/s on the move from vertex {i} exceeds the "
             f"maximum {m.max_rotation:.4g} rad/s",
             "max_rotation",
-            "slow down, spread the flip over a longer flip_length (about pi*v/max_rotation "
-            "mm) or raise",
+            f"slow down, spread each active-side flip over flip_length >= "
+            f"{math.pi * feed[i] / m.max_rotation:.2g} mm (pi * v / max_rotation at "
+            f"v = {feed[i]:g} mm/s), or raise",
         )
 
 
