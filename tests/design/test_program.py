@@ -19,7 +19,7 @@ def test_straight_path_with_rotating_nozzle_gives_minus_omega_over_v():
     slope = np.diff(prog.interface_angle) / np.diff(s_mid)
     np.testing.assert_allclose(slope, -w / v, rtol=1e-12)
     np.testing.assert_allclose(prog.rotation, w, rtol=1e-12)
-    np.testing.assert_allclose(prog.rotation_number(), 0.3 * w / v, rtol=1e-12)
+    np.testing.assert_allclose(prog.rotation_number, 0.3 * w / v, rtol=1e-12)
 
 
 def test_fixed_nozzle_on_a_circle_turns_the_interface_with_the_heading():

@@ -48,7 +48,7 @@ def test_paper_parameters_in_examples():
     assert speeds == [0.25, 0.5, 1.75, 3.0]
     for stem, frac in (("pure_lce_rotation", 1.0), ("composite_rotation", 0.5)):
         progs = load_design(next(p for p in EXAMPLES if p.stem == stem)).to_programs()
-        np.testing.assert_allclose([p.rotation_number().mean() for p in progs], [0.06, 0.25, 1, 2])
+        np.testing.assert_allclose([p.rotation_number.mean() for p in progs], [0.06, 0.25, 1, 2])
         assert all(p.active_fraction == frac and p.speed[0] == 3.0 for p in progs)
 
 
@@ -127,7 +127,7 @@ def test_controls_per_segment():
     (prog,) = parse_design(data).to_programs()
     s = prog.arc_length
     first, arc, last = s < 4.99, (s > 5.01) & (s < 5 + 2 * np.pi - 0.01), s > 5 + 2 * np.pi + 0.01
-    np.testing.assert_allclose(prog.rotation_number()[first], 0.3, rtol=1e-9)
+    np.testing.assert_allclose(prog.rotation_number[first], 0.3, rtol=1e-9)
     np.testing.assert_allclose(prog.speed[arc], 1.0)
     np.testing.assert_allclose(prog.rotation[last], 1.5, rtol=1e-9)
     # on the arc the nozzle tracks the heading: α stays at 90° there

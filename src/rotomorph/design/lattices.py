@@ -28,6 +28,7 @@ from typing import Literal, Union, cast
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.design.network import Network
 from rotomorph.design.path import Path
@@ -113,6 +114,7 @@ def _modes(pattern: Pattern, n: int, edges: IntArray, centre: str) -> tuple[str,
     return modes
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class Lattice:
     """A sinusoidal lattice: network, per-edge chains and modes, printing parameters.

@@ -10,10 +10,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidDesignError
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class Network:
     """Nodes (mm) joined by segments; every segment is one discrete-rod edge.

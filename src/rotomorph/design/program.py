@@ -41,6 +41,7 @@ from typing import Literal, Union
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray
 from rotomorph.design.path import Path
 from rotomorph.errors import InvalidDesignError
@@ -93,6 +94,7 @@ def _laid_down(t: FloatArray, nozzle_angle_edge: FloatArray) -> FloatArray:
     return m * cos[:, None] + kxm * sin[:, None] + k * (kdm * (1 - cos))[:, None]
 
 
+@compact_display("duration")
 @dataclass(frozen=True, eq=False)
 class PrintProgram:
     """What the printer does along one filament.
@@ -214,6 +216,7 @@ class PrintProgram:
         smooth = np.concatenate([[0.0], np.cumsum(np.where(flip, np.diff(psi), d_noz))])
         return self.speed * np.gradient(smooth, self.arc_length)
 
+    @property
     def rotation_number(self) -> FloatArray:
         """Dimensionless rotation rate ω* = Rω/v = R dα_n/ds per vertex ``(N,)``."""
         return self.radius * np.gradient(self.nozzle_angle, self.arc_length)

@@ -34,6 +34,7 @@ from typing import Any
 import h5py
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_path, atomic_write_text
@@ -98,6 +99,7 @@ PROGRAM_ATTRS: Mapping[str, str] = {
 }
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class RunResults:
     """Everything stored for one run (arrays are read-only).

@@ -25,6 +25,7 @@ from typing import Literal
 import numpy as np
 from scipy.spatial import cKDTree
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.area import lattice_boundary_loop, normalized_area
 from rotomorph.analysis.curvature import fit_quadratic_surface
@@ -160,6 +161,7 @@ def fused_pairs(positions: FloatArray, edges: IntArray, diameter: float) -> IntA
     return pairs[dist < diameter]
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class HeatingResult:
     """A heating ramp of a lattice; per-step arrays have ``steps + 1`` rows (row 0: printed).

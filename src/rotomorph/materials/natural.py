@@ -39,6 +39,7 @@ from typing import Any, Literal, cast
 import numpy as np
 
 from rotomorph import geometry
+from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidDesignError, InvalidParameterError, MaterialError
 from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection, filament_section
@@ -144,6 +145,7 @@ class FilamentModel:
         return e_par, e_perp, eps_p
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class NaturalField:
     """Natural (stress-free) state and stiffness of one filament in DER conventions (Frame A).

@@ -13,6 +13,7 @@ from typing import cast
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
@@ -61,6 +62,7 @@ def _default_directors(network: Network) -> FloatArray:
     return d / np.linalg.norm(d, axis=1, keepdims=True)
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class Model:
     """Discrete elastic rod model of a network (units: mm, N, MPa).

@@ -6,10 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray
 from rotomorph.rod.assembly import material_frames
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class State:
     """A configuration of a rod network.

@@ -11,17 +11,20 @@ Lattices go through :func:`rotomorph.lattice.heating.heat_lattice` (imported whe
 from __future__ import annotations
 
 import logging
+import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path as FilePath
 from typing import Any
 
 import numpy as np
 
 import rotomorph
+from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.analysis.curvature import network_relative_curvature_change
-from rotomorph.errors import InvalidDesignError
+from rotomorph.errors import InvalidDesignError, InvalidParameterError
 from rotomorph.io.designfile import design_size, with_spacing
 from rotomorph.io.results import RunResults, to_jsonable
 from rotomorph.materials.natural import FilamentModel
@@ -33,13 +36,14 @@ from rotomorph.simulate.filament import (
 )
 from rotomorph.simulate.options import check_run_options
 
-__all__ = ["DesignSimulation", "simulate_design", "step_count"]
+__all__ = ["DesignSimulation", "filaments_simulation", "simulate_design", "step_count"]
 
 Progress = Callable[[int], None]
 #: Phase messages (set-up, solve, analysis); the CLI shows them on a terminal.
 phase_log = logging.getLogger("rotomorph.progress")
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class DesignSimulation:
     """Shapes of a design over heating, in the layout of a results file.
@@ -75,6 +79,19 @@ class DesignSimulation:
     metadata: Mapping[str, Any] = field(default_factory=dict)
     filaments: tuple[FilamentSimulation, ...] = ()
     lattice: Any = None
+
+    def save(self, folder: str | os.PathLike[str], *, movie: bool = True) -> list[FilePath]:
+        """Write the run folder of ``rotomorph simulate`` into ``folder``; return the paths."""
+        from rotomorph.simulate.outputs import write_run
+
+        return write_run(self, folder, movie=movie)
+
+    def plot(self, folder: str | os.PathLike[str], *, movie: bool = False) -> list[FilePath]:
+        """Draw the run's figures (and, with ``movie``, the animation) into ``folder``."""
+        from rotomorph.simulate.outputs import plot_run
+        from rotomorph.simulate.run_data import describe_run
+
+        return plot_run(describe_run(self), folder, movie=movie)
 
     def run_results(self) -> RunResults:
         """The same data as :class:`~rotomorph.io.results.RunResults` (what the file holds)."""
@@ -168,6 +185,37 @@ def _simulate_filaments(
                 progress=progress,
             )
         )
+    return filaments_simulation(
+        sims, design.model_dump(mode="json"), temperatures=(start_temperature, temperature)
+    )
+
+
+def filaments_simulation(
+    sims: Sequence[FilamentSimulation],
+    design: Mapping[str, Any],
+    *,
+    temperatures: tuple[float, float] | None = None,
+) -> DesignSimulation:
+    """Filament simulations as one :class:`DesignSimulation` (disjoint chains of one network).
+
+    Parameters
+    ----------
+    sims
+        One or more :class:`~rotomorph.simulate.filament.FilamentSimulation` of the same ramp.
+    design
+        The design they come from (JSON-compatible), stored with the results.
+    temperatures
+        First and last temperature (°C); default: the simulations' own.
+    """
+    sims = list(sims)
+    if not sims:
+        raise InvalidParameterError("sims", "needs at least one filament simulation")
+    first = sims[0]
+    if temperatures is None:
+        temperatures = (float(first.temperature[0]), float(first.temperature[-1]))
+    steps = len(first.temperature) - 1
+    if any(len(s.temperature) != steps + 1 for s in sims):
+        raise InvalidParameterError("sims", "must all have the same number of heating steps")
     sizes = [len(s.printed) for s in sims]
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     edges = np.concatenate(
@@ -176,7 +224,6 @@ def _simulate_filaments(
             for n, o in zip(sizes, offsets, strict=False)
         ]
     )
-    first = sims[0]
     scalars = {
         "temperature": first.temperature,
         "actuation": first.actuation,
@@ -197,12 +244,14 @@ def _simulate_filaments(
             for s, o, n in zip(sims, offsets, sizes, strict=False)
         ],
         "filaments": [_filament_summary(s) for s in sims],
-        "temperature_range_degC": [start_temperature, temperature],
+        "temperature_range_degC": list(temperatures),
         "steps": steps,
+        "rotomorph_version": rotomorph.__version__,
+        "design_name": str(design.get("name", "")),
     }
     return DesignSimulation(
         kind="filaments",
-        design=design.model_dump(mode="json"),
+        design=dict(design),
         edges=edges.astype(np.int64),
         branch=np.zeros(int(offsets[-1]), dtype=bool),
         positions=np.concatenate([s.positions for s in sims], axis=1),

@@ -17,13 +17,16 @@ there (x ≈ 1e-3 at 25 °C) is not solved for, its natural field only starts th
 from __future__ import annotations
 
 import logging
+import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path as FilePath
 from typing import Any
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray
 from rotomorph.analysis.curvature import discrete_curvature
 from rotomorph.analysis.shape import (
@@ -60,6 +63,7 @@ ACTUATION_TEMPERATURE = 175.0
 Progress = Callable[[int], None]
 
 
+@compact_display("final_ratio")
 @dataclass(frozen=True, eq=False)
 class FilamentSimulation:
     """A filament's equilibrium shapes over a heating ramp.
@@ -125,6 +129,28 @@ class FilamentSimulation:
     def final_ratio(self) -> float:
         """L/L0 at the last step."""
         return float(self.end_to_end_ratio[-1])
+
+    def to_run(self) -> Any:
+        """This filament as a one-chain :class:`~rotomorph.simulate.design.DesignSimulation`."""
+        from rotomorph.simulate.design import filaments_simulation
+
+        return filaments_simulation([self], {"name": self.name, "source": "print program"})
+
+    def save(self, folder: str | os.PathLike[str], *, movie: bool = True) -> list[FilePath]:
+        """Write results.h5, summary.json, figures, movie and ParaView files into ``folder``.
+
+        The same run folder as ``rotomorph simulate`` (created if missing); returns the paths.
+        """
+        from rotomorph.simulate.outputs import write_run
+
+        return write_run(self, folder, movie=movie)
+
+    def plot(self, folder: str | os.PathLike[str], *, movie: bool = False) -> list[FilePath]:
+        """Draw the run's figures (and, with ``movie``, the animation) into ``folder``."""
+        from rotomorph.simulate.outputs import plot_run
+        from rotomorph.simulate.run_data import describe_run
+
+        return plot_run(describe_run(self.to_run()), folder, movie=movie)
 
 
 def _active_material(program: Any, materials: Mapping[str, Material] | None) -> Material:

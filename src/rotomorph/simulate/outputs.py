@@ -499,10 +499,32 @@ def run_line(results: RunResults) -> str:
 
 
 def write_run(sim: Any, folder: str | os.PathLike[str], *, movie: bool = True) -> list[Path]:
-    """Write every file of a simulation run into ``folder`` (created if missing); return paths."""
+    """Write every file of a simulation run into ``folder`` (created if missing); return paths.
+
+    ``sim`` is a :class:`~rotomorph.simulate.design.DesignSimulation`, one
+    :class:`~rotomorph.simulate.filament.FilamentSimulation` or a list of them.
+    """
     from rotomorph.simulate.run_data import describe_run
 
-    return write_run_results(describe_run(sim), folder, movie=movie)
+    return write_run_results(describe_run(as_run(sim)), folder, movie=movie)
+
+
+def as_run(sim: Any) -> Any:
+    """A :class:`~rotomorph.simulate.design.DesignSimulation` of ``sim`` (filament
+    simulations are wrapped with :func:`~rotomorph.simulate.design.filaments_simulation`)."""
+    from rotomorph.simulate.filament import FilamentSimulation
+
+    if isinstance(sim, FilamentSimulation):
+        return sim.to_run()
+    if (
+        isinstance(sim, list | tuple)
+        and sim
+        and all(isinstance(s, FilamentSimulation) for s in sim)
+    ):
+        from rotomorph.simulate.design import filaments_simulation
+
+        return filaments_simulation(sim, {"name": "", "source": "print programs"})
+    return sim
 
 
 def write_run_results(

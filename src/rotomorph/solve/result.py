@@ -7,6 +7,7 @@ from enum import Enum
 
 import numpy as np
 
+from rotomorph._display import compact_display
 from rotomorph._typing import FloatArray
 
 
@@ -21,6 +22,7 @@ class Status(Enum):
     SADDLE = "saddle"  # an equilibrium with negative curvature that could not be left
 
 
+@compact_display()
 @dataclass(frozen=True, eq=False)
 class NewtonResult:
     """Outcome of :func:`rotomorph.solve.newton.minimize`.
