@@ -73,6 +73,7 @@ DEFAULT_UNITS: Mapping[str, str] = {
     "end_to_end_ratio": "1",
     "converged": "1",
     "stable": "1",
+    "lowest_eigenvalue": "N/mm^2",
     "min_clearance": "1",
     "directors": "1",
     "active_normal": "1",

@@ -200,7 +200,8 @@ class HeatingResult:
         Rod state per step (row 0: the printed reference state); the material directors give
         the Janus sides.
     stable
-        Per step: the solver's stability verdict, ``None`` where it gave none.
+        Per step: ``True`` where the solver certified a stable minimum, ``None`` where it did
+        not check.
     lowest_eigenvalue
         Lowest Hessian eigenvalue of each equilibrium (N/mm², see
         :mod:`rotomorph.solve.stability`; NaN for row 0 and when not computed): it drops
@@ -433,8 +434,10 @@ def heat_lattice(
 
 
 def _stable_flag(result: StaticResult) -> bool | None:
-    flag = getattr(result, "stable", None)
-    return None if flag is None else bool(flag)
+    """``True`` where the solver certified a minimum; ``None`` (unknown) otherwise: a solve
+    that ends on an unstable point raises, so ``stable=False`` on a returned result means the
+    check was switched off, not that the state is unstable."""
+    return True if getattr(result, "stable", None) is True else None
 
 
 def free_edge_ratio(

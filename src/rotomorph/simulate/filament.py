@@ -98,8 +98,8 @@ class FilamentSimulation:
         Rod state per step ``(S,)`` (positions, frames): the material directors give the Janus
         sides; step 0 is the printed reference state.
     stable
-        Per step: ``True``/``False`` where the solver checked stability, ``None`` where it did
-        not (step 0, the stress-free printed state, is ``True``).
+        Per step: ``True`` where the solver certified a stable minimum, ``None`` where it did
+        not check (step 0, the stress-free printed state, is ``True``).
     program
         The print program simulated.
     lowest_eigenvalue
@@ -362,6 +362,7 @@ def simulate_filament(
 
 
 def _stable_flag(result: Any) -> bool | None:
-    """The solver's stability verdict of a result, ``None`` when it gave none."""
-    flag = getattr(result, "stable", None)
-    return None if flag is None else bool(flag)
+    """``True`` where the solver certified a minimum; ``None`` (unknown) otherwise: a solve
+    that ends on an unstable point raises, so ``stable=False`` on a returned result means the
+    check was switched off, not that the state is unstable."""
+    return True if getattr(result, "stable", None) is True else None

@@ -169,6 +169,10 @@ def _filament_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, 
             directors[:, segs], normals[:, segs] = m1, nn
         clearance[i] = chain_clearance(fil.positions, 2.0 * program.radius)
     scalars = {"stable": _combine(stable), "min_clearance": _combine(clearance)}
+    eig = [np.asarray(getattr(f, "lowest_eigenvalue", ()), dtype=float) for f in sim.filaments]
+    if eig and all(len(v) == sim.positions.shape[0] for v in eig):
+        with np.errstate(all="ignore"):
+            scalars["lowest_eigenvalue"] = np.min(np.stack(eig), axis=0)
     fields = {"directors": directors, "active_normal": normals}
     per_filament = [
         {
@@ -217,7 +221,11 @@ def _lattice_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, l
         else (np.full(sim.positions.shape[0], np.nan))
     )
     programs = [program_record(p, f"layer {p.layer}") for p in lattice.print_programs()]
-    return static, fields, {"stable": stable}, programs, [chains, []]
+    scalars = {"stable": stable}
+    eig = np.asarray(getattr(res, "lowest_eigenvalue", ()), dtype=float)
+    if len(eig) == sim.positions.shape[0]:
+        scalars["lowest_eigenvalue"] = eig
+    return static, fields, scalars, programs, [chains, []]
 
 
 def describe_run(sim: Any) -> RunResults:
