@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from rotomorph.contact import Contact, ContactPotential, Cylinder, Floor, Sphere
 from rotomorph.contact.distance import closest_parameters, segment_distance2
+from rotomorph.contact.friction import friction_energy
 from rotomorph.design.network import Network
 
 
@@ -115,3 +118,36 @@ def test_psd_mode_is_positive_semidefinite(rng):
     H = np.zeros((18, 18))
     np.add.at(H, (trip[0], trip[1]), trip[2])
     assert np.linalg.eigvalsh(H).min() >= -1e-9 * np.abs(H).max()
+
+
+@pytest.mark.parametrize("slip", [1e-2, 1e-4], ids=["sticking", "sliding"])
+def test_lagged_friction_matches_finite_differences(slip, rng):
+    """Barrier plus lagged friction (pair and floor contacts), lagged at one configuration and
+    evaluated after a tangential slip of ~1e-3 mm: inside (sticking) or beyond (sliding) the
+    smoothing slip."""
+    net, pts = _two_segments("crossing", rng)
+    contact = Contact(
+        radius=0.5,
+        obstacles=(Floor(height=-0.5045),),
+        activation_distance=0.01,
+        stiffness=1.0,
+        friction=0.5,
+        slip=slip,
+    )
+    pot = ContactPotential(contact, net)
+    pot.set_lag(pts)
+    assert pot._lag is not None and pot._lag.count >= 4  # pair contacts and floor nodes
+    moved = pts + 1e-3 * rng.standard_normal(pts.shape) * [1.0, 1.0, 0.05]
+    _check_potential(pot, moved, eps=1e-8)
+
+
+def test_friction_force_is_bounded_by_coulomb(rng):
+    net, pts = _two_segments("crossing", rng)
+    contact = Contact(radius=0.5, obstacles=(Floor(height=-0.5045),), stiffness=1.0)
+    pot = ContactPotential(replace(contact, friction=0.3, slip=1e-4), net)
+    lag = pot.lag(pts)
+    far = pts + np.array([0.05, 0.0, 0.0])  # slides everything far beyond the smoothing slip
+    _, g, _ = friction_energy(lag, pot._extended(far), True, False)
+    per_contact = np.linalg.norm(g[:3].sum(0))  # floor node forces on the lower filament
+    assert per_contact <= 0.3 * lag.normal_force.sum() * (1 + 1e-9)
+    assert lag.normal_force.min() > 0

@@ -51,22 +51,73 @@ def _psd_project(h):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def mollifier(c, eps):  # pragma: no cover - compiled
+    """``(m, m', m'')`` of IPC's edge–edge mollifier at ``c = |a x b|^2`` (Li et al. 2020,
+    eq. 10): ``m = (2 - c / eps) c / eps`` below ``eps``, 1 beyond (C¹ at ``eps``)."""
+    if c >= eps:
+        return 1.0, 0.0, 0.0
+    r = c / eps
+    return (2.0 - r) * r, (2.0 - 2.0 * r) / eps, -2.0 / (eps * eps)
+
+
+@njit(cache=True)
+def cross_norm2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - compiled
+    """``|a x b|^2 = |a|^2 |b|^2 - (a.b)^2`` of ``a = p1 - p0``, ``b = q1 - q0``; gradient (12,)
+    and, if ``need_hess``, Hessian (12, 12) in the order ``p0, p1, q0, q1``."""
+    a = p1 - p0
+    b = q1 - q0
+    A = a @ a
+    E = b @ b
+    B = a @ b
+    ga = 2.0 * E * a - 2.0 * B * b
+    gb = 2.0 * A * b - 2.0 * B * a
+    for k in range(3):
+        grad[k] = -ga[k]
+        grad[3 + k] = ga[k]
+        grad[6 + k] = -gb[k]
+        grad[9 + k] = gb[k]
+    if need_hess:
+        sa = (-1.0, 1.0)
+        for u in range(3):
+            for v in range(3):
+                eye = 1.0 if u == v else 0.0
+                haa = 2.0 * E * eye - 2.0 * b[u] * b[v]
+                hbb = 2.0 * A * eye - 2.0 * a[u] * a[v]
+                hab = 4.0 * a[u] * b[v] - 2.0 * b[u] * a[v] - 2.0 * B * eye
+                for m in range(2):
+                    for n in range(2):
+                        sg = sa[m] * sa[n]
+                        hess[3 * m + u, 3 * n + v] = sg * haa
+                        hess[6 + 3 * m + u, 6 + 3 * n + v] = sg * hbb
+                        hess[3 * m + u, 6 + 3 * n + v] = sg * hab
+                        hess[6 + 3 * n + v, 3 * m + u] = sg * hab
+    return A * E - B * B
+
+
+@njit(cache=True)
 def pair_barrier(
-    x, pairs, dmin, weight, dhat, kappa, need_grad, need_hess, grad, hloc, dist
+    x, pairs, dmin, weight, mollify, dhat, kappa, need_grad, need_hess, grad, hloc, dist
 ):  # pragma: no cover - compiled
     """Barrier energy of segment pairs ``pairs`` (P, 4) = node indices ``p0, p1, q0, q1`` of
-    ``x`` (M, 3) (a sphere repeats its centre as ``q0 = q1``).
+    ``x`` (M, 3); a point repeats its node (``p0 = p1`` for a node against a segment, ``q0 = q1``
+    for a sphere's centre).
 
-    Adds gradients to ``grad`` (M, 3); writes local Hessians ``hloc`` (P, 12, 12) when
-    ``need_hess`` is 1 (exact) or 2 (projected to positive semidefinite); writes each pair's
-    centre-line distance to ``dist`` (P,). Returns inf when any pair touches.
+    ``mollify`` (P,): IPC's mollifier threshold ``eps`` of edge–edge pairs (0: none). The
+    distance of two segments has a kink where they are parallel and overlap (the closest points
+    jump along the overlap); the mollifier fades the edge–edge term out there, and node–segment
+    pairs (smooth) carry side-by-side contact. Adds gradients to ``grad`` (M, 3); writes local
+    Hessians ``hloc`` (P, 12, 12) when ``need_hess`` is 1 (exact) or 2 (projected to positive
+    semidefinite); writes each pair's centre-line distance to ``dist`` (P,). Returns inf when
+    any pair touches.
     """
     energy = 0.0
     g = np.empty(12)
     h = np.empty((12, 12))
+    gx = np.empty(12)
+    hx = np.empty((12, 12))
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
-        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], need_hess > 0, g, h)
+        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], False, g, h)
         dist[p] = np.sqrt(D)
         zhat = (2.0 * dmin[p] + dhat) * dhat
         b, b1, b2 = barrier(D - dmin[p] * dmin[p], zhat)
@@ -76,17 +127,31 @@ def pair_barrier(
             continue
         if not np.isfinite(b):
             return np.inf
+        if need_hess:  # active pair: now its Hessian
+            segment_distance2(x[i0], x[i1], x[j0], x[j1], True, g, h)
+        m, m1, m2 = 1.0, 0.0, 0.0
+        if mollify[p] > 0.0:
+            cx = cross_norm2(x[i0], x[i1], x[j0], x[j1], need_hess > 0, gx, hx)
+            m, m1, m2 = mollifier(cx, mollify[p])
         c = kappa * weight[p]
-        energy += c * b
+        energy += c * m * b
         if need_grad:
             idx = (i0, i1, j0, j1)
             for n in range(4):
                 for k in range(3):
-                    grad[idx[n], k] += c * b1 * g[3 * n + k]
+                    q = 3 * n + k
+                    v = m * b1 * g[q]
+                    if m1 != 0.0:
+                        v += b * m1 * gx[q]
+                    grad[idx[n], k] += c * v
         if need_hess:
             for i in range(12):
                 for j in range(12):
-                    hloc[p, i, j] = c * (b2 * g[i] * g[j] + b1 * h[i, j])
+                    v = m * (b2 * g[i] * g[j] + b1 * h[i, j])
+                    if m1 != 0.0 or m2 != 0.0:
+                        v += b1 * m1 * (g[i] * gx[j] + gx[i] * g[j])
+                        v += b * (m2 * gx[i] * gx[j] + m1 * hx[i, j])
+                    hloc[p, i, j] = c * v
             if need_hess == 2:
                 hloc[p] = _psd_project(hloc[p])
     return energy

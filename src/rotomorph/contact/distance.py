@@ -20,9 +20,13 @@ with :math:`f_{xx} = 2\,w w^T \otimes I_3`,
 :math:`f_{uu} = 2\begin{pmatrix} a\cdot a & -a\cdot b \\ -a\cdot b & b\cdot b\end{pmatrix}`.
 This covers all distance types at once: edge–edge (both free), point–edge (one free) and
 point–point (none free); a zero-length Q (``q0 = q1``) is a point, which is how spheres enter.
-The function is C¹ across type changes and smooth within each type; exactly parallel
-overlapping segments are a kink of the distance itself (any segment distance has it), where the
-parallel branch fixes ``s`` at an end (Ericson, *Real-Time Collision Detection*, 2005, § 5.1.9).
+The closest points are the interior stationary point when it lies inside the unit square, else
+the best of the four edge minima (the problem is a convex quadratic); comparing all valid
+candidates keeps ``D`` continuous through (nearly) parallel configurations, where a branch on a
+parallelism threshold (Ericson, *Real-Time Collision Detection*, 2005, § 5.1.9) jumps by up to
+``|a|^2 sin^2(angle)`` — enough for a stiff barrier to stall Newton's line search. The function
+is C¹ across type changes and smooth within each type; exactly parallel overlapping segments
+are a kink of the distance itself (any segment distance has it).
 """
 
 from __future__ import annotations
@@ -46,10 +50,12 @@ def closest_parameters(p0, p1, q0, q1):  # pragma: no cover - compiled
     C = 0.0
     E = 0.0
     F = 0.0
+    R = 0.0
     for k in range(3):
         a = p1[k] - p0[k]
         b = q1[k] - q0[k]
         r = p0[k] - q0[k]
+        R += r * r
         A += a * a
         B += a * b
         C += a * r
@@ -62,16 +68,37 @@ def closest_parameters(p0, p1, q0, q1):  # pragma: no cover - compiled
         return 0.0, _clamp01(F / E)
     if E <= tiny:
         return _clamp01(-C / A), 0.0
+    # the minimum of a convex quadratic over the unit square: the interior stationary point if
+    # it lies inside, else the best of the four edge minima; taking the smallest of all valid
+    # candidates keeps D continuous, also through (nearly) parallel configurations where the
+    # interior point is ill-conditioned and skipped
+    best_s, best_t = 0.0, _clamp01(F / E)
+    best = _d2(A, B, C, E, F, best_s, best_t, R)
+    for edge in range(3):
+        if edge == 0:
+            s, t = 1.0, _clamp01((B + F) / E)
+        elif edge == 1:
+            s, t = _clamp01(-C / A), 0.0
+        else:
+            s, t = _clamp01((B - C) / A), 1.0
+        v = _d2(A, B, C, E, F, s, t, R)
+        if v < best:
+            best, best_s, best_t = v, s, t
     den = A * E - B * B
-    s = _clamp01((B * F - C * E) / den) if den > PARALLEL * A * E else 0.0
-    t = (B * s + F) / E
-    if t < 0.0:
-        t = 0.0
-        s = _clamp01(-C / A)
-    elif t > 1.0:
-        t = 1.0
-        s = _clamp01((B - C) / A)
-    return s, t
+    if den > PARALLEL * A * E:
+        s = (B * F - C * E) / den
+        t = (A * F - B * C) / den
+        if 0.0 < s < 1.0 and 0.0 < t < 1.0:
+            v = _d2(A, B, C, E, F, s, t, R)
+            if v <= best:
+                best_s, best_t = s, t
+    return best_s, best_t
+
+
+@njit(cache=True)
+def _d2(A, B, C, E, F, s, t, R):  # pragma: no cover - compiled
+    """|r + s a - t b|^2 from the Gram entries (r = p0 - q0, R = |r|^2)."""
+    return R + s * s * A + t * t * E - 2.0 * s * t * B + 2.0 * s * C - 2.0 * t * F
 
 
 @njit(cache=True)

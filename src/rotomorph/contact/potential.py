@@ -23,11 +23,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from rotomorph._typing import FloatArray, IntArray
-from rotomorph.contact.barrier import pair_barrier, plane_barrier
+from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.contact.barrier import barrier, pair_barrier, plane_barrier
 from rotomorph.contact.ccd import pair_step_bound, plane_step_bound
-from rotomorph.contact.distance import pair_distances
+from rotomorph.contact.distance import closest_parameters, pair_distances
 from rotomorph.contact.exclusion import excluded_pairs
+from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
@@ -36,6 +37,11 @@ __all__ = ["Contact", "ContactPotential", "InfeasibleContactError"]
 
 #: barrier force of a pair at half the activation distance, in units of the reference force
 ACTIVATION_FORCE = 1.0
+#: conservative-advancement sub-steps per pair before a step counts as not provably free
+#: (a pair sliding a distance L at gap g needs about L / (0.9 g) of them)
+MAX_SUBSTEPS = 100_000
+#: IPC's edge-edge mollifier threshold relative to |a|^2 |b|^2 (sin^2 of about 1.8 degrees)
+MOLLIFIER = 1e-3
 #: default activation distance relative to the smallest contact distance
 DEFAULT_ACTIVATION = 0.01
 
@@ -134,9 +140,10 @@ class Contact:
 class _Candidates:
     """Pairs near contact at one configuration (indices into the extended point array)."""
 
-    quads: IntArray  # (P, 4) p0 p1 q0 q1
+    quads: IntArray  # (P, 4) p0 p1 q0 q1 (p0 = p1: a node against a segment)
     dmin: FloatArray
     weight: FloatArray
+    mollify: FloatArray  # edge-edge mollifier threshold (0: none)
     floors: tuple[tuple[IntArray, FloatArray, FloatArray], ...]  # per floor: nodes, dmin, weight
 
     @property
@@ -211,45 +218,151 @@ class ContactPotential:
             )
         self._max_length = float(length.max())
         self._dmin_max = 2.0 * float(self.radius.max())
+        self._lag: FrictionLag | None = None
+        deg = np.bincount(edges.ravel(), minlength=n)
+        inc = -np.ones((n, max(int(deg.max()), 1)), dtype=np.int64)
+        fill = np.zeros(n, dtype=np.int64)
+        for j, (a, b) in enumerate(edges):
+            inc[a, fill[a]] = j
+            fill[a] += 1
+            inc[b, fill[b]] = j
+            fill[b] += 1
+        self._incident = inc  # segments at each node, -1 padded
+
+    # ------------------------------------------------------------------ friction
+    def set_lag(self, x0: FloatArray) -> None:
+        """Lag friction at ``x0`` (the previous equilibrium): normal forces, closest points
+        and tangent bases of every contact carrying force are frozen for the next solve.
+        Without friction (μ = 0) this does nothing."""
+        self._lag = None if self.contact.friction == 0 else self.lag(x0)
+
+    def lag(self, x0: FloatArray) -> FrictionLag:
+        """The :class:`~rotomorph.contact.friction.FrictionLag` of configuration ``x0``."""
+        x0 = np.ascontiguousarray(x0, dtype=float)
+        cand = self.candidates(x0)
+        xe = self._extended(x0)
+        nodes, weights, bases, force = [], [], [], []
+        for p in range(len(cand.quads)):
+            i0, i1, j0, j1 = cand.quads[p]
+            s, t = closest_parameters(xe[i0], xe[i1], xe[j0], xe[j1])
+            w = np.array([1.0 - s, s, -(1.0 - t), -t])
+            r = w @ xe[[i0, i1, j0, j1]]
+            d = float(np.linalg.norm(r))
+            lam = self._normal_force(d, float(cand.dmin[p]), float(cand.weight[p]))
+            if lam > 0:
+                nodes.append([i0, i1, j0, j1])
+                weights.append(w)
+                bases.append(_tangent_basis(r / d))
+                force.append(lam)
+        for f, (fn, fd, fw) in zip(self._floors, cand.floors, strict=True):
+            h = f.height_of(x0[fn])
+            for k in range(len(fn)):
+                lam = self._normal_force(float(h[k]), float(fd[k]), float(fw[k]))
+                if lam > 0:
+                    nodes.append([fn[k]] * 4)
+                    weights.append(np.array([1.0, 0.0, 0.0, 0.0]))
+                    bases.append(_tangent_basis(np.asarray(f.normal)))
+                    force.append(lam)
+        return FrictionLag(
+            nodes=np.array(nodes, dtype=np.int64).reshape(-1, 4),
+            weights=np.array(weights, dtype=float).reshape(-1, 4),
+            bases=np.array(bases, dtype=float).reshape(-1, 3, 2),
+            normal_force=np.array(force, dtype=float),
+            start=xe,
+            coefficient=float(self.contact.friction),
+            slip=self.slip,
+        )
+
+    def _normal_force(self, d: float, dmin: float, weight: float) -> float:
+        """Barrier force magnitude ``kappa w |b'(z)| 2 d`` of a pair at distance ``d`` (N)."""
+        zhat = (2.0 * dmin + self.dhat) * self.dhat
+        _, b1, _ = barrier(d * d - dmin * dmin, zhat)
+        return float(self.kappa * weight * -b1 * 2.0 * d)
 
     # ------------------------------------------------------------------ candidates
     def _extended(self, x: FloatArray) -> FloatArray:
         return np.ascontiguousarray(np.vstack([x, self._obstacle_points]), dtype=float)
 
+    def _is_excluded(self, a: IntArray, b: IntArray) -> BoolArray:
+        """Whether segment pairs ``(a, b)`` (broadcast) are graph neighbours or fused."""
+        ne = len(self.edges)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        keys = lo * ne + hi
+        if not len(self.excluded):
+            return np.asarray(lo == hi)
+        pos = np.minimum(np.searchsorted(self.excluded, keys), len(self.excluded) - 1)
+        return np.asarray((self.excluded[pos] == keys) | (lo == hi))
+
     def candidates(self, x: FloatArray, margin: float = 0.0) -> _Candidates:
         """Pairs and floor nodes whose distance may be below contact + activation + ``margin``."""
         edges = self.edges
+        ne = len(edges)
         quads: list[IntArray] = []
         dmins: list[FloatArray] = []
         weights: list[FloatArray] = []
+        molls: list[FloatArray] = []
+
+        def add(q: IntArray, d: FloatArray, w: FloatArray, m: FloatArray) -> None:
+            quads.append(q)
+            dmins.append(d)
+            weights.append(w)
+            molls.append(m)
+
         p0, p1 = x[edges[:, 0]], x[edges[:, 1]]
         mid = 0.5 * (p0 + p1)
         half = 0.5 * self._max_length
-        if self.contact.self_contact and len(edges) > 1:
+        if self.contact.self_contact and ne > 1:
             reach = self._dmin_max + self.dhat + 2 * half + margin
             pairs = cKDTree(mid).query_pairs(reach, output_type="ndarray").reshape(-1, 2)
             if len(pairs):
                 pairs = np.sort(pairs, axis=1)
-                keys = pairs[:, 0] * len(edges) + pairs[:, 1]
-                pos = np.searchsorted(self.excluded, keys)
-                pos = np.minimum(pos, max(len(self.excluded) - 1, 0))
-                hit = (
-                    self.excluded[pos] == keys if len(self.excluded) else np.zeros(len(keys), bool)
+                pairs = pairs[~self._is_excluded(pairs[:, 0], pairs[:, 1])]
+                k, j = pairs[:, 0], pairs[:, 1]
+                L = self.length
+                add(
+                    np.concatenate([edges[k], edges[j]], axis=1),
+                    self.radius[k] + self.radius[j],
+                    0.5 * (L[k] + L[j]),
+                    MOLLIFIER * (L[k] * L[j]) ** 2,
                 )
-                pairs = pairs[~hit]
-                quads.append(np.concatenate([edges[pairs[:, 0]], edges[pairs[:, 1]]], axis=1))
-                dmins.append(self.radius[pairs[:, 0]] + self.radius[pairs[:, 1]])
-                weights.append(0.5 * (self.length[pairs[:, 0]] + self.length[pairs[:, 1]]))
+                # nodes against segments: they carry side-by-side (parallel) contact
+                node = np.concatenate([edges[k, 0], edges[k, 1], edges[j, 0], edges[j, 1]])
+                seg = np.concatenate([j, j, k, k])
+                key = np.unique(node * ne + seg)
+                node, seg = key // ne, key % ne
+                inc = self._incident[node]
+                bad = ((inc >= 0) & self._is_excluded(inc, seg[:, None])).any(axis=1)
+                node, seg = node[~bad], seg[~bad]
+                add(
+                    np.stack([node, node, edges[seg, 0], edges[seg, 1]], axis=1),
+                    self.node_radius[node] + self.radius[seg],
+                    self.node_length[node],
+                    np.zeros(len(node)),
+                )
         n = self.n_nodes
-        for k, o in enumerate(self._round):
+        for io, o in enumerate(self._round):
             a = np.asarray(o.start if isinstance(o, Cylinder) else o.centre)
             b = np.asarray(o.end if isinstance(o, Cylinder) else o.centre)
             dist = _point_segment_distance(mid, a, b)
             near = np.flatnonzero(dist <= self.radius + o.radius + self.dhat + half + margin)
-            q = np.array([n + 2 * k, n + 2 * k + 1])
-            quads.append(np.concatenate([edges[near], np.tile(q, (len(near), 1))], axis=1))
-            dmins.append(self.radius[near] + o.radius)
-            weights.append(self.length[near])
+            q = np.array([n + 2 * io, n + 2 * io + 1])
+            axis2 = float(np.sum((b - a) ** 2))
+            add(
+                np.concatenate([edges[near], np.tile(q, (len(near), 1))], axis=1),
+                self.radius[near] + o.radius,
+                self.length[near],
+                MOLLIFIER * self.length[near] ** 2 * axis2,
+            )
+            if isinstance(o, Cylinder):  # nodes against the axis (a filament along the rod)
+                nodes = np.unique(edges[near])
+                add(
+                    np.stack(
+                        [nodes, nodes, np.full(len(nodes), q[0]), np.full(len(nodes), q[1])], 1
+                    ),
+                    self.node_radius[nodes] + o.radius,
+                    self.node_length[nodes],
+                    np.zeros(len(nodes)),
+                )
         floors = []
         for f in self._floors:
             h = f.height_of(x)
@@ -266,6 +379,7 @@ class ContactPotential:
             quads=np.ascontiguousarray(cat(quads) if quads else np.zeros((0, 4)), dtype=np.int64),
             dmin=np.ascontiguousarray(cat(dmins) if dmins else np.zeros(0)),
             weight=np.ascontiguousarray(cat(weights) if weights else np.zeros(0)),
+            mollify=np.ascontiguousarray(cat(molls) if molls else np.zeros(0)),
             floors=tuple(floors),
         )
 
@@ -286,7 +400,7 @@ class ContactPotential:
         hloc = np.zeros((P, 12, 12)) if need_hess else np.zeros((0, 12, 12))
         dist = np.empty(P)
         energy = pair_barrier(
-            xe, cand.quads, cand.dmin, cand.weight, self.dhat, self.kappa,
+            xe, cand.quads, cand.dmin, cand.weight, cand.mollify, self.dhat, self.kappa,
             need_grad, int(need_hess), grad, hloc, dist,
         )  # fmt: skip
         if not np.isfinite(energy):
@@ -303,15 +417,31 @@ class ContactPotential:
             energy += e
             blocks.append(blk)
         fl_h = np.concatenate(blocks) if blocks else np.zeros((0, 3, 3))
+        extra_quads = extra_h = None
+        if self._lag is not None:
+            ef, gf, hf = friction_energy(self._lag, xe, need_grad, bool(need_hess))
+            energy += ef
+            if gf is not None:
+                grad += gf
+            extra_quads, extra_h = self._lag.nodes, hf
         g = grad[: self.n_nodes] if need_grad else None
-        hess = self._triplets(cand, hloc, fl_h) if need_hess else None
+        hess = self._triplets(cand, hloc, fl_h, extra_quads, extra_h) if need_hess else None
         return float(energy), g, hess
 
     def _triplets(
-        self, cand: _Candidates, hloc: FloatArray, fl_h: FloatArray
+        self,
+        cand: _Candidates,
+        hloc: FloatArray,
+        fl_h: FloatArray,
+        extra_quads: IntArray | None = None,
+        extra_h: FloatArray | None = None,
     ) -> tuple[IntArray, IntArray, FloatArray]:
         n3 = 3 * self.n_nodes
-        dof = (cand.quads[:, :, None] * 3 + np.arange(3)).reshape(-1, 12)
+        quads = cand.quads
+        if extra_quads is not None and extra_h is not None and len(extra_quads):
+            quads = np.concatenate([quads, extra_quads])
+            hloc = np.concatenate([hloc, extra_h])
+        dof = (quads[:, :, None] * 3 + np.arange(3)).reshape(-1, 12)
         active = (
             np.flatnonzero(np.abs(hloc).reshape(len(hloc), -1).max(axis=1) > 0)
             if len(hloc)
@@ -343,7 +473,7 @@ class ContactPotential:
         xe = self._extended(x)
         dxe = np.zeros_like(xe)
         dxe[: self.n_nodes] = dx
-        t = pair_step_bound(xe, dxe, cand.quads, cand.dmin, close_fraction, 200)
+        t = pair_step_bound(xe, dxe, cand.quads, cand.dmin, close_fraction, MAX_SUBSTEPS)
         for f, (nodes, dmin, _) in zip(self._floors, cand.floors, strict=True):
             bound = plane_step_bound(
                 xe, dxe, nodes, np.asarray(f.normal), f.height, dmin, close_fraction
@@ -395,6 +525,15 @@ class ContactPotential:
                 f"{d[k]:.4g} mm < {dmin[k]:.4g} mm); start from a separated configuration, move "
                 "the obstacles away, or widen Contact.reach",
             )
+
+
+def _tangent_basis(normal: FloatArray) -> FloatArray:
+    """Orthonormal ``(3, 2)`` basis of the plane perpendicular to unit ``normal``."""
+    a = np.cross(normal, [1.0, 0.0, 0.0])
+    if np.linalg.norm(a) < 0.5:
+        a = np.cross(normal, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    return np.stack([a, np.cross(normal, a)], axis=1)
 
 
 def _point_segment_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:

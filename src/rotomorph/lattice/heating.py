@@ -30,6 +30,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.area import lattice_boundary_loop, normalized_area
 from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.analysis.shape import edge_end_to_end_ratios, end_to_end_ratio
+from rotomorph.contact import Contact, Floor
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidParameterError
 from rotomorph.geometry import parallel_transport, unit
@@ -206,6 +207,13 @@ class HeatingResult:
         Lowest Hessian eigenvalue of each equilibrium (N/mm², see
         :mod:`rotomorph.solve.stability`; NaN for row 0 and when not computed): it drops
         toward 0 where the lattice approaches a bifurcation.
+    contact
+        The contact settings of the ramp (None: filaments may pass through each other).
+    contacts_active
+        With contact: pairs and floor nodes carrying contact force at each step.
+    floor_lift
+        With a floor: highest node above its resting height (centre line at ``r`` above the
+        floor) at each step (mm).
     """
 
     parameter: FloatArray
@@ -227,6 +235,9 @@ class HeatingResult:
     states: tuple[State, ...] = ()
     stable: tuple[bool | None, ...] = ()
     lowest_eigenvalue: FloatArray = field(default_factory=lambda: np.zeros(0))
+    contact: Contact | None = None
+    contacts_active: IntArray | None = None
+    floor_lift: FloatArray | None = None
 
     @property
     def final_area_ratio(self) -> float:
@@ -243,6 +254,16 @@ class HeatingResult:
         diameters (the last step if they never do)."""
         hit = np.flatnonzero(self.min_clearance < threshold)
         return int(max(hit[0] - 1, 0)) if len(hit) else len(self.parameter) - 1
+
+    def first_lift_off(self, height: float | None = None) -> float | None:
+        """First ramp parameter at which a node rises more than ``height`` (mm; default one
+        filament diameter) above its resting height on the floor; None if it never does or
+        there is no floor."""
+        if self.floor_lift is None:
+            return None
+        h = 2.0 * self.lattice.radius if height is None else float(height)
+        hit = np.flatnonzero(self.floor_lift > h)
+        return None if not len(hit) else float(self.parameter[hit[0]])
 
     def first_overlap(self, threshold: float = 1.0) -> float | None:
         """First ramp parameter at which filaments come closer than ``threshold`` diameters."""
@@ -318,6 +339,9 @@ def heat_lattice(
     perturbation: float = 1e-3,
     options: NewtonOptions | None = None,
     max_halvings: int = 6,
+    contact: bool | Contact = False,
+    floor: bool | Floor = False,
+    friction: float = 0.0,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -340,7 +364,8 @@ def heat_lattice(
         touching a perimeter branch node clamped: position and frame fixed) or
         ``"pinned-centre"`` (the central branch node pinned, e.g. to carry gravity).
     gravity
-        Optional self-weight (:func:`lattice_gravity`); needs supports other than ``"free"``.
+        Optional self-weight (:func:`lattice_gravity`); a free lattice needs a ``floor`` to
+        rest on, otherwise supports other than ``"free"``.
     seed
         Seed of the symmetry-breaking noise.
     perturbation
@@ -349,6 +374,17 @@ def heat_lattice(
         Newton settings of every solve; default :data:`RAMP_OPTIONS`.
     max_halvings
         Step halvings allowed per ramp step.
+    contact
+        ``True``: filaments touch instead of passing through each other (radius
+        ``lattice.radius``; :class:`rotomorph.contact.Contact` with defaults), or a ``Contact``
+        to set radius, activation distance, obstacles or friction yourself.
+    floor
+        ``True``: a frictionless floor just below the printed lattice (the bath bottom:
+        centre lines at ``1.005 r`` above it), or a :class:`rotomorph.contact.Floor`. Turns
+        contact on. On a floor, a free lattice keeps only its in-plane rigid motions free
+        (they are removed from every Newton step).
+    friction
+        Coulomb coefficient of every contact (lagged per ramp step; default 0).
 
     Returns
     -------
@@ -371,22 +407,27 @@ def heat_lattice(
         )
     options = RAMP_OPTIONS if options is None else options
     sup = _supports(lattice, supports)
-    if gravity is not None and sup.is_free:
-        raise InvalidParameterError(
-            "supports", "gravity needs a support: use 'pinned-centre' or 'clamped-boundary'"
-        )
     stiffness, fm = default_stiffness(act, stiffness)
     lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
     loads = Loads(gravity=gravity)
     dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
     initial = perturbed_state(lm.model, dz)
+    settings = _contact_settings(lattice, initial.positions, contact, floor, friction)
+    if gravity is not None and sup.is_free and (settings is None or settings.floor is None):
+        raise InvalidParameterError(
+            "supports",
+            "gravity on a free lattice needs a floor to rest on (floor=True) or a support "
+            "('pinned-centre' or 'clamped-boundary')",
+        )
     values = np.linspace(act.start, act.end, int(steps) + 1)
 
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
 
     def solve(p: float, state: State) -> StaticResult:
         try:
-            res = solve_static(act.natural(lm, p), sup, loads, initial=state, options=options)
+            res = solve_static(
+                act.natural(lm, p), sup, loads, initial=state, options=options, contact=settings
+            )
         except ConvergenceError as err:
             events.append((p, int(getattr(err.result, "iterations", 0)), False))
             raise
@@ -410,6 +451,16 @@ def heat_lattice(
     fused = fused_pairs(ref, lattice.network.edges, 2.0 * lattice.radius)
     rows = [_measure(lattice, p, ref, loop, fused) for p in positions]
     ratios = np.stack([r[3] for r in rows])
+    clearance = np.array([r[4] for r in rows])
+    active = lift = None
+    if settings is not None:
+        pot = path.final.contact
+        # allowed pairs only (graph neighbours and printed fusions excluded), in r_a + r_b
+        clearance = np.array([pot.clearance(p) for p in positions])
+        active = np.array([pot.active_contacts(p) for p in positions], dtype=np.int64)
+        if settings.floor is not None:
+            rest = settings.floor.height + lattice.radius
+            lift = np.array([float(settings.floor.height_of(p).max() - rest) for p in positions])
     return HeatingResult(
         parameter=values,
         positions=positions,
@@ -422,7 +473,7 @@ def heat_lattice(
         characteristic_curvature=np.array([r[2] for r in rows]),
         mean_edge_strain=ratios.mean(axis=1) - 1.0,
         edge_ratios=ratios,
-        min_clearance=np.array([r[4] for r in rows]),
+        min_clearance=clearance,
         wall_time=wall,
         lattice=lattice,
         model=lm,
@@ -430,6 +481,9 @@ def heat_lattice(
         states=(lm.model.reference_state(), *(r.state for r in path.results)),
         stable=(True, *(_stable_flag(r) for r in path.results)),
         lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues],
+        contact=settings,
+        contacts_active=active,
+        floor_lift=lift,
     )
 
 
@@ -438,6 +492,34 @@ def _stable_flag(result: StaticResult) -> bool | None:
     that ends on an unstable point raises, so ``stable=False`` on a returned result means the
     check was switched off, not that the state is unstable."""
     return True if getattr(result, "stable", None) is True else None
+
+
+def _contact_settings(
+    lattice: Lattice,
+    printed: FloatArray,
+    contact: bool | Contact,
+    floor: bool | Floor,
+    friction: float,
+) -> Contact | None:
+    """The ramp's contact settings from the ``contact``/``floor``/``friction`` arguments."""
+    if isinstance(floor, Floor):
+        fl: Floor | None = floor
+    elif floor:
+        fl = Floor(height=float(printed[:, 2].min()) - 1.005 * lattice.radius)
+    else:
+        fl = None
+    if isinstance(contact, Contact):
+        settings: Contact | None = contact
+    elif contact or fl is not None:
+        settings = Contact(radius=lattice.radius)
+    else:
+        settings = None
+    if settings is None:
+        if friction:
+            raise InvalidParameterError("friction", "needs contact=True or a floor")
+        return None
+    obstacles = settings.obstacles + ((fl,) if fl is not None else ())
+    return replace(settings, obstacles=obstacles, friction=friction or settings.friction)
 
 
 def free_edge_ratio(

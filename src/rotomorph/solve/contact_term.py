@@ -15,8 +15,6 @@ consistent. Two more duties:
 
 from __future__ import annotations
 
-from collections import OrderedDict
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -27,8 +25,6 @@ from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.sparse_cholesky import Symbolic, analyse
 
 __all__ = ["ContactTerm", "banded_to_csc"]
-
-_SYMBOLIC_CACHE = 8  # contact patterns remembered per term (a ramp revisits a few)
 
 
 class ContactTerm:
@@ -60,7 +56,12 @@ class ContactTerm:
         coord = (pos_dof[:, None] + np.arange(3)).ravel()
         self._coord_reduced = reduced[coord]  # node coordinate 3i+k -> reduced index or -1
         self._nfree = int((reduced >= 0).sum())
-        self._symbolic: OrderedDict[int, tuple[bytes, bytes, Symbolic]] = OrderedDict()
+        self._union: tuple[IntArray, IntArray] | None = None  # CSC indices, indptr
+        self._union_keys: IntArray = np.zeros(0, dtype=np.int64)
+        self._union_base_nnz = -1
+        self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
+        self._union_sym: Symbolic | None = None
+        self.analyses = 0  # symbolic analyses done (for benchmarks)
 
     # ------------------------------------------------------------------ energy
     def evaluate(
@@ -81,22 +82,49 @@ class ContactTerm:
         return e, (None if g is None else g.ravel()), hess
 
     def add_to(self, rod: BandedMatrix | SparseMatrix, contact: sp.csc_matrix) -> SparseMatrix:
-        """The rod Hessian plus the contact Hessian, with a cached symbolic analysis."""
+        """The rod Hessian plus the contact Hessian on a pattern that only grows.
+
+        Contacts come and go between Newton iterations; re-analysing the sparse pattern each
+        time would cost more than the factorization. The pattern is the union of the rod's and
+        every contact block seen so far in this solve (explicit zeros where a contact is not
+        active now); it is re-analysed only when a new block appears.
+        """
         base = banded_to_csc(rod) if isinstance(rod, BandedMatrix) else rod.csc
-        total = (base + contact).tocsc()
-        total.sum_duplicates()
-        total.sort_indices()
-        key = (total.indptr.tobytes(), total.indices.tobytes())
-        h = hash(key)
-        hit = self._symbolic.get(h)
-        if hit is not None and hit[0] == key[0] and hit[1] == key[1]:
-            self._symbolic.move_to_end(h)
-            return SparseMatrix(total, hit[2])
-        sym = analyse(total)
-        self._symbolic[h] = (key[0], key[1], sym)
-        if len(self._symbolic) > _SYMBOLIC_CACHE:
-            self._symbolic.popitem(last=False)
-        return SparseMatrix(total, sym)
+        n = base.shape[0]
+        c = contact.tocoo()
+        ckeys = c.col.astype(np.int64) * n + c.row
+        if self._union is None or self._union_base_nnz != base.nnz:
+            self._grow(base, ckeys, n)
+        keys, sym = self._union_keys, self._union_sym
+        pos = np.searchsorted(keys, ckeys)
+        pos = np.minimum(pos, len(keys) - 1)
+        if not np.array_equal(keys[pos], ckeys):
+            self._grow(base, ckeys, n)
+            keys, sym = self._union_keys, self._union_sym
+            pos = np.searchsorted(keys, ckeys)
+        data = np.zeros(len(keys))
+        data[self._base_pos] = base.data
+        np.add.at(data, pos, c.data)
+        indices, indptr = self._union
+        return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), sym)
+
+    def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int) -> None:
+        base = base.tocsc()
+        base.sort_indices()
+        bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
+        bkeys = bcol * n + base.indices
+        old = self._union_keys if self._union is not None else np.zeros(0, dtype=np.int64)
+        keys = np.union1d(np.union1d(old, bkeys), ckeys)
+        rows = (keys % n).astype(np.int32)
+        counts = np.bincount(keys // n, minlength=n)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        self._union = (rows, indptr)
+        self._union_keys = keys
+        self._union_base_nnz = base.nnz
+        self._base_pos = np.searchsorted(keys, bkeys)
+        pattern = sp.csc_matrix((np.ones(len(keys)), rows, indptr), shape=(n, n))
+        self._union_sym = analyse(pattern)
+        self.analyses += 1
 
     # ------------------------------------------------------------------ steps
     def step_bound(self, pos: FloatArray, dpos: FloatArray) -> float:

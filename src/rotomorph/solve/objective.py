@@ -122,7 +122,12 @@ class RodObjective:
         self._fixed_mask = fixed
         self._contact: ContactTerm | None = None
         self._contact_hess = None
-        self._floor_normal = None if contact is None or contact.floor is None else contact.floor
+        # a frictionless floor leaves a free body its in-plane rigid motions (projected out)
+        self._floor_normal = (
+            None
+            if contact is None or contact.floor is None or contact.friction > 0
+            else contact.floor
+        )
         self.set_base(state)
         self._setup_scales(loads)
         if contact is not None:
@@ -137,6 +142,7 @@ class RodObjective:
                 ),
             )
             self._contact.potential.check_admissible(state.positions, "initial")
+            self._contact.potential.set_lag(state.positions)  # friction lagged per solve
 
     @property
     def contact(self):  # type: ignore[no-untyped-def]

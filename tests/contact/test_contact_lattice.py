@@ -1,0 +1,29 @@
+"""Heating ramps of small lattices with contact: no overlap, the floor carries the weight."""
+
+from __future__ import annotations
+
+import pytest
+
+from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.errors import InvalidParameterError
+from rotomorph.lattice import heat_lattice
+from rotomorph.lattice.heating import lattice_gravity
+
+
+def test_contracting_lattice_on_the_floor_jams_instead_of_overlapping():
+    lat = sinusoidal_lattice(n=3, pattern="contracting")
+    free = heat_lattice(lat, steps=4)
+    res = heat_lattice(lat, steps=4, floor=True, gravity=lattice_gravity(lat))
+    assert free.min_clearance.min() < 0.5  # without contact, filaments pass through each other
+    assert res.min_clearance.min() >= 1.0  # allowed pairs, in units of r_a + r_b
+    assert res.contacts_active[-1] > 0
+    assert res.final_area_ratio > free.final_area_ratio + 0.1
+    assert res.floor_lift is not None and res.floor_lift[-1] < 2 * lat.radius  # stays flat
+
+
+def test_gravity_on_a_free_lattice_needs_a_floor():
+    lat = sinusoidal_lattice(n=2, ghost_nodes=2)
+    with pytest.raises(InvalidParameterError, match="floor"):
+        heat_lattice(lat, steps=1, gravity=lattice_gravity(lat))
+    with pytest.raises(InvalidParameterError, match="friction"):
+        heat_lattice(lat, steps=1, friction=0.3)
