@@ -12,13 +12,15 @@ from rotomorph.lattice.heating import lattice_gravity
 
 def test_contracting_lattice_on_the_floor_jams_instead_of_overlapping():
     lat = sinusoidal_lattice(n=3, pattern="contracting")
-    free = heat_lattice(lat, steps=4)
-    res = heat_lattice(lat, steps=4, floor=True, gravity=lattice_gravity(lat))
-    assert free.min_clearance.min() < 0.5  # without contact, filaments pass through each other
+    # the 'swapped' reading keeps this small case fast (10-25 Newton iterations per step)
+    free = heat_lattice(lat, steps=4, actuation="swapped")
+    res = heat_lattice(lat, steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
+    assert free.min_clearance.min() < 0.9  # without contact, filaments overlap
     assert res.min_clearance.min() >= 1.0  # allowed pairs, in units of r_a + r_b
     assert res.contacts_active[-1] > 0
     assert res.final_area_ratio > free.final_area_ratio + 0.1
     assert res.floor_lift is not None and res.floor_lift[-1] < 2 * lat.radius  # stays flat
+    assert res.first_lift_off() is None
 
 
 def test_gravity_on_a_free_lattice_needs_a_floor():

@@ -212,8 +212,7 @@ class HeatingResult:
     contacts_active
         With contact: pairs and floor nodes carrying contact force at each step.
     floor_lift
-        With a floor: highest node above its resting height (centre line at ``r`` above the
-        floor) at each step (mm).
+        With a floor: the largest rise of a node above its printed height at each step (mm).
     """
 
     parameter: FloatArray
@@ -257,7 +256,7 @@ class HeatingResult:
 
     def first_lift_off(self, height: float | None = None) -> float | None:
         """First ramp parameter at which a node rises more than ``height`` (mm; default one
-        filament diameter) above its resting height on the floor; None if it never does or
+        filament diameter) above its printed height on the floor; None if it never does or
         there is no floor."""
         if self.floor_lift is None:
             return None
@@ -459,8 +458,8 @@ def heat_lattice(
         clearance = np.array([pot.clearance(p) for p in positions])
         active = np.array([pot.active_contacts(p) for p in positions], dtype=np.int64)
         if settings.floor is not None:
-            rest = settings.floor.height + lattice.radius
-            lift = np.array([float(settings.floor.height_of(p).max() - rest) for p in positions])
+            rest = settings.floor.height_of(positions[0])
+            lift = np.array([float((settings.floor.height_of(p) - rest).max()) for p in positions])
     return HeatingResult(
         parameter=values,
         positions=positions,

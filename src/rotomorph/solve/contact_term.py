@@ -56,7 +56,7 @@ class ContactTerm:
         coord = (pos_dof[:, None] + np.arange(3)).ravel()
         self._coord_reduced = reduced[coord]  # node coordinate 3i+k -> reduced index or -1
         self._nfree = int((reduced >= 0).sum())
-        self._union: tuple[IntArray, IntArray] | None = None  # CSC indices, indptr
+        self._union: tuple[np.ndarray, np.ndarray] | None = None  # CSC indices, indptr
         self._union_keys: IntArray = np.zeros(0, dtype=np.int64)
         self._union_base_nnz = -1
         self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
@@ -96,11 +96,13 @@ class ContactTerm:
         if self._union is None or self._union_base_nnz != base.nnz:
             self._grow(base, ckeys, n)
         keys, sym = self._union_keys, self._union_sym
+        assert sym is not None and self._union is not None
         pos = np.searchsorted(keys, ckeys)
         pos = np.minimum(pos, len(keys) - 1)
         if not np.array_equal(keys[pos], ckeys):
             self._grow(base, ckeys, n)
             keys, sym = self._union_keys, self._union_sym
+            assert sym is not None
             pos = np.searchsorted(keys, ckeys)
         data = np.zeros(len(keys))
         data[self._base_pos] = base.data
