@@ -314,3 +314,35 @@ def test_example_machine_profiles(path):
     assert f"; machine: {machine.name}, profile {path.name}" in text
     for line in machine.header_lines:
         assert line in text
+
+
+def test_flow_model_pressures_scale_with_speed():
+    """A speed series on one nozzle: with conductances the pressures follow v (Poiseuille),
+    so every filament gets the same extruded section; an explicit pressure still wins."""
+    from rotomorph.io.designfile import parse_design
+
+    def filament(speed, y, **kw):
+        seg = [{"kind": "line", "length": 5.0}]
+        return {"speed": speed, "start": [10.0, y, 0.0], "spacing": 0.5, "segments": seg, **kw}
+
+    data = {
+        "schema_version": 1,
+        "nozzle": {"active_conductance": 0.02, "passive_conductance": 0.01},
+        "filaments": [
+            filament(0.25, 10.0),
+            filament(3.0, 15.0),
+            filament(3.0, 20.0, active_fraction=1.0),
+            filament(3.0, 25.0, active_pressure=50.0),
+        ],
+    }
+    process = parse_design(data).gcode_options()["process"]
+    area = np.pi * 0.3**2
+    assert process[0].active_pressure == pytest.approx(0.25 * area * 0.5 / 0.02)
+    assert process[0].passive_pressure == pytest.approx(0.25 * area * 0.5 / 0.01)
+    assert process[1].active_pressure == pytest.approx(12 * process[0].active_pressure)
+    assert process[2].active_pressure == pytest.approx(3.0 * area / 0.02)
+    assert process[2].passive_pressure == 0.0  # unused channel: not driven
+    assert process[3].active_pressure == 50.0
+    with pytest.raises(InvalidParameterError, match="passive_conductance"):
+        prog = PrintProgram.from_rotation(PrintPath.line((0, 0, 0), (1, 0, 0), 0.5), 3.0)
+        Process.from_flow(prog, active_conductance=0.02, passive_conductance=None)

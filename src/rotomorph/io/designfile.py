@@ -222,14 +222,26 @@ class _Process(_Model):
     prime_dwell: float | None = Field(None, ge=0, le=3600, description="s after pressure-on")
     release_dwell: float | None = Field(None, ge=0, le=3600, description="s after pressure-off")
 
-    def process(self, nozzle: Nozzle) -> Process:
-        """The :class:`~rotomorph.io.gcode.Process` of this filament (falls back to nozzle)."""
-        keys = ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell")
+    def process(self, nozzle: Nozzle, program: PrintProgram) -> Process:
+        """The :class:`~rotomorph.io.gcode.Process` of ``program``, printed by this filament
+        or lattice: its own pressures and dwells, else the nozzle's flow model (if the nozzle
+        gives conductances), else the nozzle's pressures and dwells."""
+        dwells = {
+            k: getattr(nozzle, k) if getattr(self, k) is None else getattr(self, k)
+            for k in ("prime_dwell", "release_dwell")
+        }
+        base = Process(nozzle.active_pressure, nozzle.passive_pressure, **dwells)
+        if nozzle.active_conductance is not None or nozzle.passive_conductance is not None:
+            base = Process.from_flow(
+                program,
+                active_conductance=nozzle.active_conductance,
+                passive_conductance=nozzle.passive_conductance,
+                **dwells,
+            )
         return Process(
-            **{
-                k: getattr(nozzle, k) if getattr(self, k) is None else getattr(self, k)
-                for k in keys
-            }
+            base.active_pressure if self.active_pressure is None else self.active_pressure,
+            base.passive_pressure if self.passive_pressure is None else self.passive_pressure,
+            **dwells,
         )
 
 
@@ -473,6 +485,12 @@ class Nozzle(_Model):
     passive_pressure: float = _ranged("pressure", 30.0, "passive channel pressure")
     prime_dwell: float = Field(0.0, ge=0, le=3600, description="s after pressure-on")
     release_dwell: float = Field(0.0, ge=0, le=3600, description="s after pressure-off")
+    active_conductance: float | None = Field(
+        None, gt=0, le=1e6, description="flow model: mm^3/s per psi of the active channel"
+    )
+    passive_conductance: float | None = Field(
+        None, gt=0, le=1e6, description="flow model: mm^3/s per psi of the passive channel"
+    )
 
 
 class Design(_Model):
@@ -519,14 +537,15 @@ class Design(_Model):
         """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (process, hash).
 
         One :class:`~rotomorph.io.gcode.Process` per program of :meth:`to_programs`, in the
-        same order: each filament's or the lattice's pressures and dwells, else the nozzle's.
+        same order: each filament's or the lattice's pressures and dwells, else the nozzle's
+        flow model (``active_conductance``, ``passive_conductance``), else its pressures.
         """
-        owners: list[tuple[int, _Process]] = [(f.layer, f) for f in self.filaments]
+        owners: list[tuple[_Process, PrintProgram]] = [(f, f.to_program()) for f in self.filaments]
         if self.lattice is not None:
             lattice = self.lattice
-            owners += [(p.layer, lattice) for p in lattice.to_lattice().print_programs()]
-        owners.sort(key=lambda pair: pair[0])  # stable, as to_programs
-        process = [owner.process(self.nozzle) for _, owner in owners]
+            owners += [(lattice, p) for p in lattice.to_lattice().print_programs()]
+        owners.sort(key=lambda pair: pair[1].layer)  # stable, as to_programs
+        process = [owner.process(self.nozzle, prog) for owner, prog in owners]
         return {"process": process, "design_hash": self.sha256()}
 
     def sha256(self) -> str:

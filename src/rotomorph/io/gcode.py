@@ -118,6 +118,47 @@ class Process:
             if v < 0:
                 raise InvalidParameterError(f"Process.{name}", f"must be >= 0; got {v!r}")
 
+    @classmethod
+    def from_flow(
+        cls,
+        program: PrintProgram,
+        *,
+        active_conductance: float | None,
+        passive_conductance: float | None,
+        prime_dwell: float = 0.0,
+        release_dwell: float = 0.0,
+    ) -> Process:
+        r"""Pressures from a linear (Hagen–Poiseuille) flow model of each channel.
+
+        The channels must together deliver the filament's volume rate
+        :math:`Q = \bar v\,\pi R^2`, split by the active fraction φ:
+        :math:`P_a = \bar v \pi R^2 \varphi / k_a` and
+        :math:`P_p = \bar v \pi R^2 (1-\varphi) / k_p`, with :math:`\bar v` the filament's
+        mean speed (length / duration, mm/s) and :math:`k` a channel's conductance
+        (mm³/s per psi), which the lab measures for its ink and nozzle (a fit to its own
+        extrusion tests, not a prediction). A channel the filament does not use gets 0.
+
+        Raises
+        ------
+        InvalidParameterError
+            A used channel without a conductance > 0.
+        """
+        rate = float(program.arc_length[-1]) / program.duration * np.pi * program.radius**2
+        psi = {}
+        for role, share, k in (
+            ("active", program.active_fraction, active_conductance),
+            ("passive", 1.0 - program.active_fraction, passive_conductance),
+        ):
+            if share <= 0:
+                psi[role] = 0.0
+            elif k is None or not (math.isfinite(k) and k > 0):
+                raise InvalidParameterError(
+                    f"{role}_conductance", f"must be > 0 mm^3/s per psi for a flow model; got {k}"
+                )
+            else:
+                psi[role] = rate * share / k
+        return cls(psi["active"], psi["passive"], prime_dwell, release_dwell)
+
     def channels(self, active_fraction: float) -> list[tuple[str, float]]:
         """``(role, psi)`` of the channels a filament with ``active_fraction`` drives."""
         out = []
