@@ -33,6 +33,6 @@ def test_fig5_example(capsys):
     forces = hot["rod_forces_N"]
     assert min(forces) > 1e-3  # every rod held (N)
     assert max(forces) == pytest.approx(min(forces), rel=1e-6)  # the four rods alike
-    assert max(released["rod_forces_N"]) == 0.0  # released on cooling
+    assert max(released["rod_forces_N"]) < 1e-6  # released on cooling (barrier tail only)
     assert all(r["clearance"] >= 0.999 for r in grip if r["clearance"] is not None)
     assert geometry["minimum_spacing_mm"] < 7.0  # the assumed spacing admits the rods
