@@ -146,6 +146,22 @@ def test_simulate_filament_writes_everything(tmp_path, capsys):
     res = read_results(out / "results.h5")
     assert res.n_steps == 4 and res.positions.shape[2] == 3
     assert res.scalars["end_to_end_ratio"][-1] < 0.95  # the composite coils
+    # the stored Janus side: printed, the program's interface normals; coiled, the active half
+    # (which contracts more) faces the centre of curvature
+    from rotomorph.design.program import PrintProgram
+
+    (prog,) = res.programs
+    printed = PrintProgram(points=prog["points"], speed=prog["speed"],
+                           nozzle_angle=prog["nozzle_angle"], radius=prog["radius"])  # fmt: skip
+    np.testing.assert_allclose(res.fields["active_normal"][0], printed.interface_normals, atol=1e-9)
+    p, n = res.positions[-1], res.fields["active_normal"][-1]
+    towards = p[:-2] + p[2:] - 2 * p[1:-1]
+    both = n[:-1] + n[1:]
+    cos = np.einsum("ij,ij->i", towards, both) / (
+        np.linalg.norm(towards, axis=1) * np.linalg.norm(both, axis=1)
+    )
+    assert np.median(cos) > 0.95
+    assert res.units["twist"] == "1/mm" and res.static["arc_length"][-1] == pytest.approx(10.0)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["n_steps"] == 4
     assert summary["end_of_ramp"]["end_to_end_ratio"] == pytest.approx(
