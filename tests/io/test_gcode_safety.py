@@ -83,19 +83,72 @@ def test_unknown_material_refused_like_validate(tmp_path, capsys):
         assert "unobtainium" in capsys.readouterr().err
 
 
-PROFILE_STRINGS = ("name", "pressure_template", "uv_on_template", "uv_off_template")
+PROFILE_STRINGS = (
+    "name",
+    "dialect",
+    "pressure_idiom",
+    "pressure_template",
+    "valve_on_template",
+    "valve_off_template",
+    "dwell_template",
+    "uv_on_template",
+    "uv_off_template",
+    "rotary_units",
+    "rotary_rebase",
+    "x_axis",
+    "y_axis",
+    "z_axis",
+    "rotary_axis",
+)
+PROFILE_LINES = ("setup_lines", "end_lines", "header_lines", "footer_lines")
+_SUFFIX = {
+    "pressure_template": " {port} {psi}",
+    "valve_on_template": " {port}",
+    "valve_off_template": " {port}",
+    "dwell_template": " {s}",
+}
 
 
-@pytest.mark.parametrize("key", PROFILE_STRINGS)
+@pytest.mark.parametrize("key", PROFILE_STRINGS + PROFILE_LINES)
 @pytest.mark.parametrize("bad", INJECT)
 def test_injection_through_every_profile_string(tmp_path, key, bad):
-    value = bad + (" {port} {psi}" if key == "pressure_template" else "")
+    value: object = bad + _SUFFIX.get(key, "")
+    if key in PROFILE_LINES:
+        value = ["G90", value]
+    base = {"dialect": "rs274"} | {key: value}
     with pytest.raises(InvalidParameterError, match=f"'{key}'"):
-        MachineProfile(dialect="rs274", **{key: value})
+        MachineProfile(**base)  # type: ignore[arg-type]
     f = tmp_path / "m.toml"
-    f.write_text(f'[machine]\ndialect = "rs274"\n{key} = {_toml_str(value)}\n')
+    toml = (
+        "[" + ", ".join(_toml_str(v) for v in value) + "]"
+        if isinstance(value, list)
+        else _toml_str(str(value))
+    )
+    dialect = "" if key == "dialect" else 'dialect = "rs274"\n'
+    f.write_text(f"[machine]\n{dialect}{key} = {toml}\n")
     with pytest.raises(InvalidParameterError, match=f"'{key}'"):
         load_machine_profile(f)
+
+
+def test_injection_through_a_header_file(tmp_path):
+    (tmp_path / "h.txt").write_bytes(b"DVAR $a\r\nG0 Z-50\x1b\n")
+    f = tmp_path / "m.toml"
+    f.write_text('[machine]\nheader_file = "h.txt"\n')
+    with pytest.raises(InvalidParameterError, match="header_lines"):
+        load_machine_profile(f)
+
+
+@pytest.mark.parametrize("role", ["active_material", "passive_material"])
+def test_injection_through_lattice_materials(tmp_path, capsys, role):
+    design = tmp_path / "lattice.toml"
+    design.write_text(
+        "schema_version = 1\n[lattice]\nn = 2\nghost_nodes = 2\nlayers = 1\n"
+        f"origin = [20.0, 20.0, 0.0]\n{role} = {_toml_str('lce' + chr(10) + 'G0 Z-50')}\n"
+    )
+    out = tmp_path / "p.gcode"
+    assert main(["gcode", str(design), "-o", str(out)]) == EXIT_USAGE
+    assert not out.exists()
+    capsys.readouterr()
 
 
 def test_axis_letters_and_ports_cannot_inject():
@@ -226,15 +279,15 @@ EXAMPLES = Path(__file__).parents[2] / "examples" / "designs"
 def test_cli_preview_and_check(tmp_path, capsys):
     from PIL import Image
 
-    out = tmp_path / "dome.gcode"
+    out = tmp_path / "sinusoids.gcode"
     machine = str(MACHINES / "linuxcnc.toml")
-    design = str(EXAMPLES / "lattice_dome.toml")
+    design = str(EXAMPLES / "sinusoids.toml")
     assert main(["gcode", design, "-o", str(out), "--machine", machine, "--preview"]) == EXIT_OK
     img = np.asarray(Image.open(out.with_suffix(".png")).convert("RGB"), dtype=float)
     assert img.std() > 5.0 and np.sum(np.ptp(img, axis=2) > 40) > 500
     capsys.readouterr()
     assert main(["gcode", "--check", str(out), "--machine", machine]) == EXIT_OK
-    assert "ok: 30 filament(s)" in capsys.readouterr().out
+    assert "ok: 2 filament(s)" in capsys.readouterr().out
     bad = tmp_path / "bad.gcode"
     bad.write_text(out.read_text().replace("M65 P0\n", "", 1))
     assert main(["gcode", "--check", str(bad), "--machine", machine]) == EXIT_USAGE
