@@ -142,3 +142,18 @@ def test_aerotech_matches_mecode_calls(shape, idiom):
     if shape == "straight":
         words = [float(c) for c in re.findall(r"^G1 .* C(\S+)$", ours, flags=re.M)]
         assert math.isclose(words[-1], math.degrees(10.0 / 3.0 * 4.0), rel_tol=1e-9)
+
+
+def test_check_reads_a_mecode_program_without_rotomorph_comments():
+    """`gcode --check` reads any program in the dialect, not only rotomorph's own."""
+    from rotomorph.io.gcode_read import check_gcode
+
+    prog = _programs()["sinusoid"]
+    machine = MachineProfile(dialect="aerotech", pressure_idiom="nordson", travel_feed=20.0)
+    text = "\n".join(_mecode_print(prog, "nordson", (30.0, 25.0), 0.5, machine.lift)) + "\n"
+    report = check_gcode(text, machine)
+    (filament,) = report.filaments
+    assert filament.pressure == {"active": 30.0, "passive": 25.0}
+    assert filament.prime_dwell == 0.5
+    np.testing.assert_allclose(filament.program.points, prog.points, atol=1e-6)
+    assert report.max_rotation <= machine.max_rotation
