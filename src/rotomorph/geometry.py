@@ -128,27 +128,33 @@ def space_parallel_directors(points: FloatArray, first: FloatArray | None = None
 @njit(cache=True)
 def _transport_chain(t, d0, out):  # pragma: no cover - compiled
     """Sequential parallel transport of ``d0`` along the tangents ``t`` (see above)."""
-    out[0] = d0
+    # scalars only: array temporaries and row assignment would compile numba's shape-checking
+    # and error-formatting machinery (about 15 % of the first-run compile time)
+    out[0, 0], out[0, 1], out[0, 2] = d0[0], d0[1], d0[2]
     for i in range(1, t.shape[0]):
-        a = t[i - 1]
-        b = t[i]
-        u = out[i - 1]
-        bx = a[1] * b[2] - a[2] * b[1]
-        by = a[2] * b[0] - a[0] * b[2]
-        bz = a[0] * b[1] - a[1] * b[0]
+        a0, a1, a2 = t[i - 1, 0], t[i - 1, 1], t[i - 1, 2]
+        b0, b1, b2 = t[i, 0], t[i, 1], t[i, 2]
+        u0, u1, u2 = out[i - 1, 0], out[i - 1, 1], out[i - 1, 2]
+        bx = a1 * b2 - a2 * b1
+        by = a2 * b0 - a0 * b2
+        bz = a0 * b1 - a1 * b0
         s = np.sqrt(bx * bx + by * by + bz * bz)
         if s < _PARALLEL_TOL:
-            v = u.copy()
+            v0, v1, v2 = u0, u1, u2
         else:
             bx, by, bz = bx / s, by / s, bz / s
-            n1 = np.array([a[1] * bz - a[2] * by, a[2] * bx - a[0] * bz, a[0] * by - a[1] * bx])
-            n2 = np.array([b[1] * bz - b[2] * by, b[2] * bx - b[0] * bz, b[0] * by - b[1] * bx])
-            ua = u[0] * a[0] + u[1] * a[1] + u[2] * a[2]
-            un = u[0] * n1[0] + u[1] * n1[1] + u[2] * n1[2]
-            ub = u[0] * bx + u[1] * by + u[2] * bz
-            v = ua * b + un * n2 + ub * np.array([bx, by, bz])
-        v = v - (v[0] * b[0] + v[1] * b[1] + v[2] * b[2]) * b
-        out[i] = v / np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            n10, n11, n12 = a1 * bz - a2 * by, a2 * bx - a0 * bz, a0 * by - a1 * bx
+            n20, n21, n22 = b1 * bz - b2 * by, b2 * bx - b0 * bz, b0 * by - b1 * bx
+            ua = u0 * a0 + u1 * a1 + u2 * a2
+            un = u0 * n10 + u1 * n11 + u2 * n12
+            ub = u0 * bx + u1 * by + u2 * bz
+            v0 = ua * b0 + un * n20 + ub * bx
+            v1 = ua * b1 + un * n21 + ub * by
+            v2 = ua * b2 + un * n22 + ub * bz
+        vb = v0 * b0 + v1 * b1 + v2 * b2
+        v0, v1, v2 = v0 - vb * b0, v1 - vb * b1, v2 - vb * b2
+        norm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        out[i, 0], out[i, 1], out[i, 2] = v0 / norm, v1 / norm, v2 / norm
 
 
 def rotate_about_tangent(d1: FloatArray, t: FloatArray, angle: FloatArray) -> FloatArray:

@@ -248,22 +248,30 @@ class _Process(_Model):
 class Filament(_Control, _Process):
     """One filament: a chain of segments and how to print it."""
 
-    name: str = Field("", max_length=200)
+    name: str = Field("", max_length=200, description="label in results and figures")
     speed: Speed = 3.0
-    active_side: Literal["outer", "inner"] | None = None
+    active_side: Literal["outer", "inner"] | None = Field(
+        None, description="keep the active half on this side of the curvature"
+    )
     flip_length: float = Field(
         0.0, ge=0, le=LIMITS["extent"].maximum, description="mm over which active-side flips turn"
     )
-    start: Vec3 = (0.0, 0.0, 0.0)
+    start: Vec3 = Field((0.0, 0.0, 0.0), description="first vertex (mm)")
     heading_deg: float = _ranged("angle_deg", 0.0, "initial heading")
     initial_nozzle_angle_deg: float = _ranged("angle_deg", 0.0, "initial nozzle angle")
     spacing: float = _ranged("vertex_spacing", 0.1, "rod vertex spacing")
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: str = Field("lce", min_length=1, max_length=100)
-    passive_material: str = Field("acrylate", min_length=1, max_length=100)
+    active_material: str = Field(
+        "lce", min_length=1, max_length=100, description="registered active material"
+    )
+    passive_material: str = Field(
+        "acrylate", min_length=1, max_length=100, description="registered passive material"
+    )
     layer: int = _ranged("layer", 0, "printed layer")
-    segments: list[SegmentModel] = Field(min_length=1, max_length=MAX_NODES)
+    segments: list[SegmentModel] = Field(
+        min_length=1, max_length=MAX_NODES, description="the path, segment by segment"
+    )
 
     @field_validator("active_material")
     @classmethod
@@ -401,22 +409,32 @@ class LatticeModel(_Process):
     """The paper's sinusoidal lattice (:func:`rotomorph.design.lattices.sinusoidal_lattice`)."""
 
     n: int = _ranged("lattice_n", 5, "branch nodes per side")
-    spacing: Length = 5.0
+    spacing: float = _ranged("extent", 5.0, "branch-node spacing l")
     amplitude: float = Field(
         1.25, ge=0, le=LIMITS["extent"].maximum, description="sine amplitude A (mm)"
     )
     ghost_nodes: int = _ranged("ghost_nodes", 10, "rod nodes inside each edge")
-    pattern: Literal["expanding", "contracting", "dome", "saddle", "custom"] = "expanding"
-    edge_modes: list[Literal["expanding", "contracting"]] | None = None
-    centre: Literal["central_cells", "interior"] = "central_cells"
+    pattern: Literal["expanding", "contracting", "dome", "saddle", "custom"] = Field(
+        "expanding", description="edge modes: all, or centre vs rest (dome/saddle), or custom"
+    )
+    edge_modes: list[Literal["expanding", "contracting"]] | None = Field(
+        None, description="one mode per lattice edge, 2n(n-1) of them (pattern = custom)"
+    )
+    centre: Literal["central_cells", "interior"] = Field(
+        "central_cells", description="which edges count as central for dome/saddle"
+    )
     layers: int = _ranged("layers", 3, "printed layers")
     layer_height: float = _ranged("layer_height", 0.6, "layer height")
     speed: Speed = 3.0
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: str = Field("lce", min_length=1, max_length=100)
-    passive_material: str = Field("acrylate", min_length=1, max_length=100)
-    origin: Vec3 = (0.0, 0.0, 0.0)
+    active_material: str = Field(
+        "lce", min_length=1, max_length=100, description="registered active material"
+    )
+    passive_material: str = Field(
+        "acrylate", min_length=1, max_length=100, description="registered passive material"
+    )
+    origin: Vec3 = Field((0.0, 0.0, 0.0), description="where the lattice is printed (mm)")
     flip_length: float = Field(
         0.0,
         ge=0,
@@ -496,12 +514,14 @@ class Nozzle(_Model):
 class Design(_Model):
     """A validated design file (filaments and/or a lattice)."""
 
-    schema_version: Literal[1] = SCHEMA_VERSION
-    name: str = Field("", max_length=200)
-    description: str = Field("", max_length=10_000)
-    nozzle: Nozzle = Nozzle()
-    filaments: list[Filament] = Field(default_factory=list, max_length=10_000)
-    lattice: LatticeModel | None = None
+    schema_version: Literal[1] = Field(SCHEMA_VERSION, description="format version; write 1")
+    name: str = Field("", max_length=200, description="label stored with results and G-code")
+    description: str = Field("", max_length=10_000, description="free text")
+    nozzle: Nozzle = Field(Nozzle(), description="nozzle and pressures for G-code")
+    filaments: list[Filament] = Field(
+        default_factory=list, max_length=10_000, description="filaments (or a lattice, not both)"
+    )
+    lattice: LatticeModel | None = Field(None, description="one sinusoidal lattice")
 
     @field_validator("schema_version", mode="before")
     @classmethod

@@ -193,8 +193,7 @@ def max_edge_rotation(x, dx, edges):  # pragma: no cover - compiled
     return np.sqrt(worst)
 
 
-@njit(cache=True)
-def remove_rigid_motion(x, dx, m, t, dtheta, mtheta):  # pragma: no cover - compiled
+def remove_rigid_motion(x, dx, m, t, dtheta, mtheta):
     """Subtract from ``(dx, dtheta)`` its M-orthogonal projection on rigid motions (in place).
 
     A small rigid rotation ``omega`` moves node ``i`` by ``omega x r_i`` *and* turns each edge's
@@ -204,7 +203,19 @@ def remove_rigid_motion(x, dx, m, t, dtheta, mtheta):  # pragma: no cover - comp
     rotation solving ``G omega = b`` with
     ``G = sum m (|r|^2 I - r r^T) + sum m_theta t t^T`` and
     ``b = sum m r x dx + sum m_theta dtheta t``.
+
+    The sums and the update are compiled; the 3 x 3 least-squares solve (minimum-norm where a
+    straight rod leaves the rotation about its axis free) is NumPy's, which keeps LAPACK's
+    compiled bindings out of the kernel (a quarter of the first-run compile time).
     """
+    c, tr, G, b = _rigid_moments(x, dx, m, t, dtheta, mtheta)
+    omega = np.linalg.lstsq(G, b, rcond=-1)[0]
+    _subtract_rigid(x, dx, t, dtheta, c, tr, omega)
+
+
+@njit(cache=True)
+def _rigid_moments(x, dx, m, t, dtheta, mtheta):  # pragma: no cover - compiled
+    """Centroid, mean displacement, ``G`` and ``b`` of :func:`remove_rigid_motion`."""
     n = x.shape[0]
     mt = 0.0
     c = np.zeros(3)
@@ -236,8 +247,13 @@ def remove_rigid_motion(x, dx, m, t, dtheta, mtheta):  # pragma: no cover - comp
             b[a] += mtheta[j] * dtheta[j] * t[j, a]
             for k in range(3):
                 G[a, k] += mtheta[j] * t[j, a] * t[j, k]
-    omega = np.linalg.lstsq(G, b)[0]
-    for i in range(n):
+    return c, tr, G, b
+
+
+@njit(cache=True)
+def _subtract_rigid(x, dx, t, dtheta, c, tr, omega):  # pragma: no cover - compiled
+    """``(dx, dtheta) -= translation tr + rotation omega about c`` (in place)."""
+    for i in range(x.shape[0]):
         r0, r1, r2 = x[i, 0] - c[0], x[i, 1] - c[1], x[i, 2] - c[2]
         dx[i, 0] -= tr[0] + omega[1] * r2 - omega[2] * r1
         dx[i, 1] -= tr[1] + omega[2] * r0 - omega[0] * r2
