@@ -399,7 +399,7 @@ def plot_tube_panels(
         ax.set_xlim(c[0] - half[0], c[0] + half[0])
         ax.set_ylim(c[1] - half[1], c[1] + half[1])
         ax.set_zlim(c[2] - half[2], c[2] + half[2])
-        ax.set_box_aspect(tuple(half), zoom=1.0)
+        ax.set_box_aspect(tuple(half), zoom=0.94)
         ax.view_init(elev=elev, azim=azim)
         ax.set_axis_off()
         # scale bar along x at the bottom front of the box
