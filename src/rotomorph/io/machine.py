@@ -317,6 +317,8 @@ class MachineProfile:
                 raise _bad(key, f"is not a valid template ({exc}); got {text!r}") from None
             if not used <= allowed:
                 raise _bad(key, f"may only use fields {sorted(allowed)}; got {sorted(used)}")
+            if "port" in allowed and text and "port" not in used:
+                raise _bad(key, "must name the channel with {port} (the two channels differ)")
         if self.pressure_idiom == "template":
             if not self.pressure_template and not self.valve_on_template:
                 raise _bad("pressure_template", "give a set-point or valve template")
