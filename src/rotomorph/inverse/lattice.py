@@ -222,7 +222,13 @@ def _integrated_factor(model: Model) -> FloatArray:
 
 @dataclass(frozen=True, eq=False)
 class LatticeBlend:
-    """Natural values of a lattice as a linear function of per-edge design variables.
+    """Natural values of a lattice as a function of per-edge design variables ``c``.
+
+    Stencils inside one lattice edge depend on that edge's mode only: their natural values are
+    the linear blend ``w+(c) K[+] + w-(c) K[-]`` with ``w±(c) = (1 ± c)/2`` of the values of the
+    printable modes. Junction stencils couple two edges ``e, f`` (a printed line passing through
+    a node, or a crossing) and may depend on both modes: their values are the bilinear blend of
+    the four printable combinations. Rest lengths belong to one edge each.
 
     Attributes
     ----------
@@ -230,11 +236,15 @@ class LatticeBlend:
         The printed geometry (its own pattern is irrelevant).
     model
         The printed rod model (zero actuation).
-    printed, expanding, contracting
-        Integrated natural values ``(S, 3)`` and rest lengths ``(E,)`` of the printed state and
-        of the fully actuated all-expanding and all-contracting lattices.
-    stencil_edge
-        Lattice edge of every stencil ``(S,)`` (−1 for junction stencils).
+    printed
+        Integrated natural values ``(S, 3)`` and rest lengths ``(E,)`` of the printed state.
+    combos
+        ``(S, 2, 2, 3)``: fully actuated integrated naturals of every stencil for its two edges'
+        modes ``[mode of edge_a, mode of edge_b]`` (index 0 expanding, 1 contracting).
+    rest
+        ``(2, E)``: fully actuated rest lengths for each mode.
+    stencil_edges
+        ``(S, 2)`` lattice edges ``(a, b)`` of each stencil's two segments (equal inside an edge).
     segment_edge
         Lattice edge of every network segment ``(E,)``.
     """
@@ -242,9 +252,9 @@ class LatticeBlend:
     lattice: Lattice
     model: Model
     printed: tuple[FloatArray, FloatArray]
-    expanding: tuple[FloatArray, FloatArray]
-    contracting: tuple[FloatArray, FloatArray]
-    stencil_edge: IntArray
+    combos: FloatArray
+    rest: FloatArray
+    stencil_edges: IntArray
     segment_edge: IntArray
     factor: FloatArray = field(repr=False)
 
@@ -253,27 +263,40 @@ class LatticeBlend:
         """Number of lattice edges (design variables)."""
         return len(self.lattice.edge_chains)
 
+    def _weights(self, c: FloatArray) -> tuple[FloatArray, FloatArray]:
+        c = np.asarray(c, dtype=float)
+        ca, cb = c[self.stencil_edges[:, 0]], c[self.stencil_edges[:, 1]]
+        wa = np.stack([0.5 * (1 + ca), 0.5 * (1 - ca)], axis=1)
+        wb = np.stack([0.5 * (1 + cb), 0.5 * (1 - cb)], axis=1)
+        return wa, wb
+
     def natural(self, c: FloatArray, t: float = 1.0) -> tuple[FloatArray, FloatArray]:
         """Integrated naturals ``(S, 3)`` and rest lengths ``(E,)`` at design ``c`` and ramp
         fraction ``t`` (0 = printed, 1 = fully actuated)."""
-        c = np.asarray(c, dtype=float)
-        ws = np.where(self.stencil_edge >= 0, c[np.maximum(self.stencil_edge, 0)], 0.0)
-        wl = c[self.segment_edge]
+        wa, wb = self._weights(c)
+        full = np.einsum("si,sj,sijk->sk", wa, wb, self.combos)
         k0, l0 = self.printed
-        ke, le = self.expanding
-        kc, lc = self.contracting
-        k = k0 + t * (0.5 * (1 + ws)[:, None] * (ke - k0) + 0.5 * (1 - ws)[:, None] * (kc - k0))
-        rest = l0 + t * (0.5 * (1 + wl) * (le - l0) + 0.5 * (1 - wl) * (lc - l0))
-        return k, rest
+        cs = np.asarray(c, dtype=float)[self.segment_edge]
+        rest_full = 0.5 * (1 + cs) * self.rest[0] + 0.5 * (1 - cs) * self.rest[1]
+        return k0 + t * (full - k0), l0 + t * (rest_full - l0)
 
-    def derivative(self) -> tuple[FloatArray, FloatArray]:
-        """``d(naturals)/dc_e`` per stencil ``(S, 3)`` and per segment ``(E,)`` at t = 1 (the
-        dependence is linear; each stencil and segment depends on its own edge only)."""
-        ke, le = self.expanding
-        kc, lc = self.contracting
-        dk = 0.5 * (ke - kc)
-        dk[self.stencil_edge < 0] = 0.0
-        return dk, 0.5 * (le - lc)
+    def gradient(
+        self, c: FloatArray, products: FloatArray, rest_products: FloatArray
+    ) -> FloatArray:
+        """``d/dc`` of ``sum(products * naturals) + sum(rest_products * rest)`` at t = 1.
+
+        ``products`` ``(S, 3)`` and ``rest_products`` ``(E,)`` are e.g. the adjoint products
+        ``lambda^T dg/d(natural)`` of :func:`rotomorph.rod.sensitivity.natural_sensitivity`.
+        """
+        wa, wb = self._weights(c)
+        dw = np.array([0.5, -0.5])
+        da = np.einsum("i,sj,sijk->sk", dw, wb, self.combos)  # d(naturals)/dc_a
+        db = np.einsum("si,j,sijk->sk", wa, dw, self.combos)  # d(naturals)/dc_b
+        g = np.zeros(self.n_edges)
+        np.add.at(g, self.stencil_edges[:, 0], np.sum(products * da, axis=1))
+        np.add.at(g, self.stencil_edges[:, 1], np.sum(products * db, axis=1))
+        np.add.at(g, self.segment_edge, rest_products * 0.5 * (self.rest[0] - self.rest[1]))
+        return g
 
     def rod(self, c: FloatArray, t: float = 1.0) -> Model:
         """The rod model at design ``c`` and ramp fraction ``t``."""
@@ -291,18 +314,18 @@ def _values(model: Model) -> tuple[FloatArray, FloatArray]:
     return np.stack([k1, k2, tw], axis=1), np.array(model.rest_length, dtype=float)
 
 
-def lattice_blend(lattice: Lattice, actuation: str | Actuation | None = None) -> LatticeBlend:
+def lattice_blend(
+    lattice: Lattice, actuation: str | Actuation | None = None, *, seed: int = 0
+) -> LatticeBlend:
     """Build the :class:`LatticeBlend` of ``lattice`` for an actuation mode (default: the
-    package's default lattice actuation) at its full actuation."""
+    package's default lattice actuation) at its full actuation.
+
+    The four mode combinations of every junction stencil are read off fully actuated lattices
+    of a few patterns (uniform ones, then random ones until every combination is seen); a
+    combination seen in two patterns must give the same values, else the actuation is not
+    local to the two edges and the blend refuses it.
+    """
     act = get_actuation(actuation) if actuation is not None else _default_actuation()
-    models = {}
-    for mode in ("expanding", "contracting"):
-        lat = _with_pattern(lattice, mode)
-        lm = lattice_model(lat)
-        models[mode] = act.natural(lm, act.end)
-        if "printed" not in models:
-            models["printed"] = act.natural(lm, act.start)
-    base = lattice_model(lattice).model
     net = lattice.network
     seg_lookup = {}
     for j, (a, b) in enumerate(net.edges):
@@ -311,18 +334,58 @@ def lattice_blend(lattice: Lattice, actuation: str | Actuation | None = None) ->
     for e, chain in enumerate(lattice.edge_chains):
         for a, b in itertools.pairwise(chain):
             segment_edge[seg_lookup[(int(min(a, b)), int(max(a, b)))]] = e
+    base = lattice_model(lattice).model
     st = base.stencils
-    se, sf = segment_edge[st.edge_e], segment_edge[st.edge_f]
-    stencil_edge = np.where((se == sf) & ~np.asarray(st.junction, dtype=bool), se, -1)
+    pairs = np.stack([segment_edge[st.edge_e], segment_edge[st.edge_f]], axis=1)
+    n_edges = len(lattice.edge_chains)
+    combos = np.full((st.count, 2, 2, 3), np.nan)
+    rest = np.full((2, net.n_edges), np.nan)
+    printed = None
+    rng = np.random.default_rng(seed)
+    same = pairs[:, 0] == pairs[:, 1]
+    patterns = [np.zeros(n_edges, dtype=int), np.ones(n_edges, dtype=int)]
+    for _ in range(24):
+        if patterns:
+            modes = patterns.pop(0)
+        elif not (np.isnan(combos[~same]).any() or np.isnan(rest).any()):
+            break
+        else:
+            modes = rng.integers(0, 2, n_edges)
+        lat = _with_pattern(
+            lattice, {e: ("expanding", "contracting")[int(m)] for e, m in enumerate(modes)}
+        )
+        lm = lattice_model(lat)
+        if printed is None:
+            printed = _values(act.natural(lm, act.start))
+        k, r = _values(act.natural(lm, act.end))
+        ia, ib = modes[pairs[:, 0]], modes[pairs[:, 1]]
+        seen = combos[np.arange(st.count), ia, ib]
+        known = ~np.isnan(seen[:, 0])
+        if np.any(np.abs(seen[known] - k[known]) > 1e-9 * (1 + np.abs(k[known]))):
+            raise InvalidParameterError(
+                "actuation",
+                f"{act.name!r} is not local to the two edges of a junction; inverse design "
+                "needs an actuation whose natural values depend on each edge's own mode",
+            )
+        combos[np.arange(st.count), ia, ib] = k
+        rest[modes[segment_edge], np.arange(net.n_edges)] = r
+    # inside one edge both modes move together: the off-diagonal combinations are the mean of
+    # the diagonal ones, which makes the bilinear blend linear there (w+ + w- = 1)
+    mean = 0.5 * (combos[same, 0, 0] + combos[same, 1, 1])
+    combos[same, 0, 1] = mean
+    combos[same, 1, 0] = mean
+    if np.isnan(combos).any() or np.isnan(rest).any() or printed is None:
+        raise InvalidParameterError("lattice", "could not sample every mode combination")
+    printed_model = act.natural(lattice_model(lattice), act.start)
     return LatticeBlend(
         lattice=lattice,
-        model=models["printed"],
-        printed=_values(models["printed"]),
-        expanding=_values(models["expanding"]),
-        contracting=_values(models["contracting"]),
-        stencil_edge=stencil_edge,
+        model=printed_model,
+        printed=printed,
+        combos=combos,
+        rest=rest,
+        stencil_edges=pairs,
         segment_edge=segment_edge,
-        factor=_integrated_factor(models["printed"]),
+        factor=_integrated_factor(printed_model),
     )
 
 
@@ -553,7 +616,6 @@ def design_lattice(
     blend = lattice_blend(lattice, actuation)
     size = lattice.spacing * (lattice.n - 1)
     eq = _Equilibria(blend, seed=seed)
-    dk, dl = blend.derivative()
     if initial is None:
         c0 = np.array([1.0 if m == "expanding" else -1.0 for m in lattice.edge_mode]) * 0.9
     else:
@@ -584,12 +646,8 @@ def design_lattice(
         except NotAMinimumError:
             return np.inf, np.zeros_like(c)
         s = adj.sensitivity
-        prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1) * dk
-        grad = np.zeros(n_edges)
-        mask = blend.stencil_edge >= 0
-        np.add.at(grad, blend.stencil_edge[mask], prod[mask].sum(axis=1))
-        np.add.at(grad, blend.segment_edge, s.rest_length * dl)
-        grad = -grad
+        prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1)
+        grad = -blend.gradient(c, prod, s.rest_length)
         j += weight[0] * float(np.sum(1.0 - c * c))
         grad += weight[0] * (-2.0 * c)
         history.append(j)
