@@ -21,39 +21,21 @@ import argparse
 import json
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import ellipe, ellipk
 
+from rotomorph.rod.cases import EulerColumnCase
 from rotomorph.rod.model import Model
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.stability import stability
 from rotomorph.solve.static import solve_static
 
-YOUNG, RADIUS, LENGTH = 1.0, 0.3, 10.0  # MPa, mm, mm
-BENDING = YOUNG * np.pi * RADIUS**4 / 4  # B, N mm^2
+COLUMN = EulerColumnCase()  # clamped-free, L = 10 mm, r = 0.3 mm, E = 1 MPa
+YOUNG, RADIUS, LENGTH = COLUMN.young, COLUMN.radius, COLUMN.length  # MPa, mm, mm
+BENDING = COLUMN.bending_stiffness  # B, N mm^2
 TWIST = BENDING / 1.3  # C = G J with Poisson's ratio 0.3, N mm^2
-EULER = np.pi**2 * BENDING / (4 * LENGTH**2)  # clamped-free Euler load, N
-
-
-def column(n: int) -> Model:
-    """A straight column; its clamped first edge is centred on the origin (the clamp)."""
-    h = LENGTH / (n - 1.5)
-    s = -h / 2 + h * np.arange(n)
-    return Model.chain(
-        np.c_[s, 0 * s, 0 * s],
-        bending_stiffness1=BENDING,
-        bending_stiffness2=BENDING,
-        twist_stiffness=TWIST,
-        axial_stiffness=100 * YOUNG * np.pi * RADIUS**2,  # nearly inextensible
-    )
-
-
-def elastica_tip(ratio: float) -> tuple[float, float]:
-    """Tip (x, lateral) / L of the clamped-free elastica at ``ratio`` x the Euler load."""
-    big_k = np.sqrt(ratio) * np.pi / 2  # sqrt(P/B) L = K(k)
-    m = brentq(lambda m: ellipk(m) - big_k, 1e-12, 1 - 1e-14)
-    return 2 * ellipe(m) / big_k - 1, 2 * np.sqrt(m) / big_k
+EULER = COLUMN.euler_load  # clamped-free Euler load, N
+column = COLUMN.model  # its clamped first edge is centred on the origin (the clamp)
+elastica_tip = COLUMN.elastica_tip  # tip (x, lateral) / L of the elastica
 
 
 def buckled_column(n: int) -> dict:

@@ -13,7 +13,6 @@ import pytest
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.lattice.heating import RAMP_OPTIONS, heat_lattice
 
-
 ACT = "swapped"
 
 

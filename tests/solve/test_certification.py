@@ -11,11 +11,11 @@ import doctest
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq, rosen, rosen_der, rosen_hess
-from scipy.special import ellipe, ellipk
+from scipy.optimize import rosen, rosen_der, rosen_hess
 
 import rotomorph.solve.stability as stability_module
 from rotomorph.errors import InvalidParameterError
+from rotomorph.rod.cases import EulerColumnCase
 from rotomorph.rod.model import Model
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.newton import FunctionObjective, NewtonOptions, minimize
@@ -24,35 +24,13 @@ from rotomorph.solve.result import Status
 from rotomorph.solve.stability import stability
 from rotomorph.solve.static import solve_static
 
-E, RADIUS, LENGTH = 1.0, 0.3, 10.0  # MPa, mm, mm
-B = E * np.pi * RADIUS**4 / 4  # N mm²
-P_CR = np.pi**2 * B / (4 * LENGTH**2)  # clamped–free Euler load (N)
+CASE = EulerColumnCase()
+E, RADIUS, LENGTH = CASE.young, CASE.radius, CASE.length  # MPa, mm, mm
+B = CASE.bending_stiffness  # N mm²
+P_CR = CASE.euler_load  # clamped–free Euler load (N)
 RAMP = NewtonOptions(rtol=1e-7, max_iterations=300)  # the lattice ramps' tolerance
-
-
-def column(n: int) -> Model:
-    """A straight isotropic column whose clamped first edge is centred on the origin, so the
-    free length from the clamp (the midpoint of that edge) to the loaded tip is LENGTH."""
-    h = LENGTH / (n - 1.5)
-    s = -h / 2 + h * np.arange(n)
-    return Model.chain(
-        np.c_[s, 0 * s, 0 * s],
-        bending_stiffness1=B,
-        bending_stiffness2=B,
-        twist_stiffness=B / 1.3,
-        axial_stiffness=100 * E * np.pi * RADIUS**2,  # nearly inextensible
-    )
-
-
-def elastica_tip(ratio: float) -> tuple[float, float]:
-    """Tip of the clamped–free elastica under ``ratio`` x P_cr: (x, lateral) / L.
-
-    ``sqrt(P/B) L = K(k)``, ``x/L = 2E(k)/K(k) - 1``, ``y/L = 2k/K(k)`` with ``k = sin(a/2)``
-    and ``a`` the tip rotation (Timoshenko & Gere, *Theory of Elastic Stability*, § 2.7).
-    """
-    K = np.sqrt(ratio) * np.pi / 2
-    m = brentq(lambda m: ellipk(m) - K, 1e-12, 1 - 1e-14)
-    return 2 * ellipe(m) / K - 1, 2 * np.sqrt(m) / K
+column = CASE.model
+elastica_tip = CASE.elastica_tip
 
 
 @pytest.mark.parametrize("options", [None, RAMP], ids=["default-tol", "ramp-tol"])
