@@ -214,10 +214,14 @@ class Fit:
         w, v = np.linalg.eigh(cov)
         return v * np.sqrt(np.clip(w, 0.0, None))
 
-    def propagate(self, quantity: Predictor) -> tuple[FloatArray, FloatArray]:
+    def propagate(
+        self, quantity: Predictor, *, central: bool = True
+    ) -> tuple[FloatArray, FloatArray]:
         """Value at the optimum and propagated standard deviation of ``quantity(model)``.
 
         See the module docstring (secants over ± one standard deviation per direction).
+        ``central = False`` uses one-sided secants θ̂ → θ̂ + L e_k (half the evaluations, for
+        expensive quantities; first order like the central ones).
         """
         centre = np.asarray(quantity(self.model), dtype=float)
         var = np.zeros_like(centre)
@@ -225,8 +229,11 @@ class Fit:
             if not np.any(d):
                 continue
             up = np.asarray(quantity(self.model_at(self.theta + d)), dtype=float)
-            down = np.asarray(quantity(self.model_at(self.theta - d)), dtype=float)
-            var = var + (0.5 * (up - down)) ** 2
+            if central:
+                down = np.asarray(quantity(self.model_at(self.theta - d)), dtype=float)
+                var = var + (0.5 * (up - down)) ** 2
+            else:
+                var = var + (up - centre) ** 2
         return centre, np.sqrt(var)
 
     def record(self) -> dict[str, Any]:

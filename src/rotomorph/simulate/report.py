@@ -37,11 +37,13 @@ from typing import Any
 import numpy as np
 
 import rotomorph
+from rotomorph._typing import FloatArray
 from rotomorph.errors import ConvergenceError, RotomorphError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import write_summary
 from rotomorph.materials import FilamentModel, load_table
 from rotomorph.materials.calibrate import filament_shapes, janus_curvature
+from rotomorph.materials.inference import Fit
 from rotomorph.simulate.cache import disk_cached
 from rotomorph.simulate.validation import (
     FILAMENT_SPACINGS,
@@ -238,6 +240,9 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 LATTICE_GHOSTS = {True: (6, 12), False: (10, 20)}
 #: Heating steps of the full lattice ramps.
 LATTICE_STEPS = 8
+#: Heating steps of the perturbed ramps that propagate the calibration's uncertainty (the
+#: final state of an elastic ramp does not depend on the steps once each converges).
+SD_STEPS = 4
 
 
 def _heat(
@@ -245,16 +250,19 @@ def _heat(
 ) -> tuple[Any, Any, str]:
     """(lattice, HeatingResult or None, reason): heated through the materials chain."""
     try:
-        from rotomorph.lattice.actuation import ThermalActuation
+        from rotomorph.lattice import actuation as modes
         from rotomorph.lattice.heating import heat_lattice
     except ImportError as err:  # pragma: no cover - module missing
         return None, None, f"lattice module not available ({err})"
+    # each edge from its print program where the lattice layer provides it, else every edge
+    # with the Janus section's curvature and centre-line strain at the print speed
+    mode = getattr(modes, "ProgramActuation", modes.ThermalActuation)
     from rotomorph.design.lattices import sinusoidal_lattice
 
     n = 3 if quick else 5
     lattice = sinusoidal_lattice(n, 5.0, 1.25, ghosts, pattern)  # type: ignore[arg-type]
     try:
-        actuation = ThermalActuation(filament_model=model)
+        actuation = mode(filament_model=model)
         key = repr((pattern, n, ghosts, steps, actuation))
         result = disk_cached(
             "heat_lattice", key, lambda: heat_lattice(lattice, actuation=actuation, steps=steps)
@@ -265,8 +273,19 @@ def _heat(
         return lattice, None, f"lattice solver failed: {' '.join(str(err).split())[:160]}"
 
 
+def _area_sd(fit: Fit, pattern: str, quick: bool, ghosts: int) -> float | None:
+    """Calibration sd of a lattice's final area (one-sided secants, :data:`SD_STEPS` steps)."""
+
+    def area(m: FilamentModel) -> FloatArray:
+        _, res, _ = _heat(pattern, quick, SD_STEPS, at_resolution(m), ghosts)
+        return np.array([np.nan if res is None else res.final_area_ratio])
+
+    _, sd = fit.propagate(area, central=False)
+    return float(sd[0]) if np.isfinite(sd[0]) else None
+
+
 def _lattice_section(
-    model: FilamentModel,
+    fit: Fit,
     figs: Path | None,
     *,
     quick: bool,
@@ -274,6 +293,7 @@ def _lattice_section(
     tick: Callable[[], None],
 ) -> tuple[list[dict], list[Path]]:
     """Lattice rows and, unless ``figs`` is None, their figures."""
+    model = at_resolution(fit.model)
     from rotomorph.analysis.curvature import network_relative_curvature_change
     from rotomorph.plot.figure import new_figure, save_figure
     from rotomorph.plot.shapes import plot_lattice_views
@@ -304,6 +324,9 @@ def _lattice_section(
                 measured,
                 spread,
                 None if fine[pattern] is None else fine[pattern].final_area_ratio,
+                predicted_sd=None
+                if quick or res is None
+                else _area_sd(fit, pattern, quick, coarse_g),
                 other=None if res is None else res.final_area_ratio,
                 resolution=(coarse_g, fine_g),
                 resolution_unit="ghost nodes per edge",
@@ -312,8 +335,9 @@ def _lattice_section(
                 figure="fig3g_lattice_area.png",
                 note=why
                 or f"{size} lattice heated {res.parameter[0]:.0f} → {res.parameter[-1]:.0f} °C "
-                f"through the calibrated materials chain ('{res.actuation}'); calibration "
-                "uncertainty not propagated (cost); measured A/A0 = 1 + change (%)/100; "
+                f"through the calibrated materials chain ('{res.actuation}'); sd by one-sided "
+                f"secants at {coarse_g} ghost nodes (none in quick mode); measured A/A0 = 1 + "
+                "change (%)/100; "
                 f"contact not modelled (min clearance {np.min(res.min_clearance):.2f} "
                 "diameters)",
             )
@@ -439,7 +463,11 @@ def paper_rows(*, quick: bool = False) -> tuple[list[dict[str, Any]], dict[str, 
     """
     val = validate_filaments()
     lattice, _ = _lattice_section(
-        val.model, None, quick=quick, steps=3 if quick else LATTICE_STEPS, tick=lambda: None
+        val.calibrations["all"].chosen,
+        None,
+        quick=quick,
+        steps=3 if quick else LATTICE_STEPS,
+        tick=lambda: None,
     )
     rows = _ordered(val, lattice)
     return rows, summarise(rows)
@@ -680,7 +708,9 @@ def paper_report(
         ("Fig. 3C/D", lambda: _sinusoid_section(val, figs)),
         (
             "lattices (Fig. 3G, 4)",
-            lambda: _lattice_section(val.model, figs, quick=quick, steps=lattice_steps, tick=tick),
+            lambda: _lattice_section(
+                val.calibrations["all"].chosen, figs, quick=quick, steps=lattice_steps, tick=tick
+            ),
         ),
     ):
         t = time.perf_counter()
