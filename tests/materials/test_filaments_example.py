@@ -46,7 +46,10 @@ def test_example_rows_and_json_lines() -> None:
         by.setdefault(r["quantity"], []).append(r["condition"])
     assert len(by["janus_curvature"]) == 4 and len(by["pure_lce_length_L_over_L0"]) == 4
     assert len(by["composite_length_L_over_L0"]) == 2
-    assert len(by["sinusoid_end_to_end_ratio"]) == 2
+    # the counted ideal-flip sinusoids and the printable design shown next to them
+    assert len(by["sinusoid_end_to_end_ratio"]) == 4
+    sinus = [r for r in rows if r["quantity"] == "sinusoid_end_to_end_ratio"]
+    assert [r["counted"] for r in sinus] == [True, True, False, False]
     # fits/inputs are never counted; every counted row is out of sample with an uncertainty
     for r in rows:
         if r["calibration"]:

@@ -46,7 +46,7 @@ def test_free_shape_equals_rod_solver(which) -> None:
 def test_report_sinusoid_is_the_example_design() -> None:
     design = load_design(DESIGNS / "sinusoids.toml")
     for fil, side in zip(design.filaments, ("outer", "inner"), strict=True):
-        ours = sinusoid_filament(side, fil.spacing).to_program()
+        ours = sinusoid_filament(side, fil.spacing).to_program()  # the printable variant
         theirs = fil.to_program()
         a, b = ours.points - ours.points[0], theirs.points - theirs.points[0]
         np.testing.assert_allclose(a, b, atol=1e-9)

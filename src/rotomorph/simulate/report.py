@@ -47,6 +47,7 @@ from rotomorph.materials.inference import Fit
 from rotomorph.simulate.cache import disk_cached
 from rotomorph.simulate.validation import (
     FILAMENT_SPACINGS,
+    SINUSOID_DESIGN,
     Validation,
     at_resolution,
     free_shape,
@@ -219,6 +220,7 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
     from rotomorph.simulate.validation import _program
 
     rows = [r for r in val.rows if r["quantity"] == "sinusoid_end_to_end_ratio"]
+    shown = [r for r in rows if r["counted"]]
     fig = new_figure(10.0, 4.0)
     axes = fig.subplots(1, 2)
     for i, (side, label) in enumerate((("outer", "expanding"), ("inner", "contracting"))):
@@ -227,7 +229,11 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
         ax = axes[i]
         ax.plot(prog.points[:, 0], prog.points[:, 1], "k--", lw=1, label="printed")
         ax.plot(x[:, 0], x[:, 1], "r-", lw=1,
-                label=f"175 °C, L/L0 = {rows[i]['predicted']:.2f}")  # fmt: skip
+                label=f"175 °C, step flips: L/L0 = {shown[i]['predicted']:.2f}")  # fmt: skip
+        flip = SINUSOID_DESIGN["flip_length"]
+        xp = sinusoid_shape(side, val.model, FILAMENT_SPACINGS[1], flip)
+        xp = xp - xp[0] + x[0]
+        ax.plot(xp[:, 0], xp[:, 1], "b:", lw=1, label=f"175 °C, {flip:g} mm flips (printable)")
         ax.legend(fontsize=8)
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"Fig. 3{'C' if side == 'outer' else 'D'}: {label} (active {side})")
@@ -648,9 +654,11 @@ def prediction_table(rows: list[dict[str, Any]], summary: dict[str, Any]) -> str
         if r["calibration"]:
             how = "input / fit"
         elif r["counted"]:
-            how = "out of sample" + ("" if r["converged"] else ", NOT converged")
+            how = "out of sample"
         else:
             how = "not counted"
+        if r["predicted"] is not None and not r["converged"]:
+            how += ", NOT converged"
         z = "—" if r["z"] is None else f"{r['z']:+.1f}"
         lines.append(
             f"| {r['quantity']} | {r['condition']} | {_pm(r['measured'], r['spread'])} | "
