@@ -242,7 +242,7 @@ def test_simulate_lattice(tmp_path, capsys):
     res = read_results(out / "results.h5")
     assert res.scalars["area_ratio"][-1] > 1.2  # expanding
     assert "relative_curvature_change" in res.fields
-    for png in ("shapes.png", "lattice_views.png", "lattice_metrics.png"):
+    for png in ("shapes.png", "lattice_field.png", "lattice_views.png", "lattice_metrics.png"):
         _non_blank_png(out / "figures" / png)
     assert "active_normal" in res.fields and "lattice_edge" in res.static
     assert (out / "paraview" / "morphing.pvd").exists()

@@ -15,6 +15,8 @@ Folder layout::
     figures/ramp.png        filaments: states across the heating ramp
     figures/end_to_end_ratio.png                filaments: L/L0 over temperature
     figures/lattice_views.png                   lattices: top/side coloured by (κ − κ_i)/κ_i
+    figures/lattice_field.png                   lattices: the tubes of shapes.png coloured by
+                                                (κ − κ_i)/κ_i on the scale of the physical states
     figures/lattice_metrics.png                 lattices: area, curvature vs strain
     figures/morphing.mp4    the morphing (GIF where no ffmpeg is installed)
     paraview/morphing.pvd   + morphing_0000.vtp …: polylines with point data per step
@@ -210,6 +212,41 @@ def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     )
 
 
+def _lattice_field_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any | None:
+    """The shapes of :func:`_shapes_figure` as tubes coloured by the curvature field (paper
+    Fig. 4): one colour scale for all panels, set by the states that pass the checks, that
+    round-off cannot stretch."""
+    from rotomorph.plot.shapes import scalar_norm, segment_values
+    from rotomorph.plot.tubes import plot_tube_panels
+
+    name, label = colour_field(results)
+    if name is None or results.fields[name].shape[1] != results.positions.shape[1]:
+        return None
+    steps = _lattice_steps(results, verdicts)
+    last = results.n_steps - 1
+    values = {k: segment_values(results.fields[name][k], results.edges) for k in steps}
+    # the scale of the states that pass the checks (a state that is not physical may reach any
+    # value; it is clipped to this scale rather than setting it)
+    scaled = [k for k in steps if verdicts[k].verdict != "no" and k > 0] or steps
+    norm = scalar_norm(np.concatenate([values[k] for k in scaled]))
+    panels = []
+    for k in steps:
+        head = "printed" if k == 0 else ("end of ramp" if k == last else "before the failure")
+        mark = {"no": "\nNOT PHYSICAL", "unknown": "\nunverified"}.get(verdicts[k].verdict, "")
+        p = _lattice_panel(results, k, f"{head}, {_labels(results)[k]}{mark}")
+        panels.append(type(p)(**{**p.__dict__, "values": values[k]}))
+    title, colour = _state_title(results, last, verdicts)
+    return plot_tube_panels(
+        panels,
+        columns=3,
+        norm=norm,
+        label=label,
+        cmap="coolwarm",
+        suptitle=title,
+        suptitle_colour=colour,
+    )
+
+
 def _filament_step_verdict(results: RunResults, i: int, k: int, verdicts: list[StepVerdict]) -> str:
     """Verdict of filament ``i`` at step ``k``: its own where the run stored one, else the run's."""
     info = results.metadata.get("filaments", [])
@@ -381,6 +418,9 @@ def plot_run(
     paths = [save_figure(_shapes_figure(results, verdicts), out / "shapes.png")]
     if _kind(results) == "lattice":
         paths.append(save_figure(_lattice_views(results, verdicts), out / "lattice_views.png"))
+        field_fig = _lattice_field_figure(results, verdicts)
+        if field_fig is not None:
+            paths.append(save_figure(field_fig, out / "lattice_field.png"))
         paths.append(
             save_figure(_lattice_metrics_figure(results, verdicts), out / "lattice_metrics.png")
         )
