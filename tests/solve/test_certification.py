@@ -179,3 +179,19 @@ def test_a_stiff_rod_converges_at_its_round_off_floor():
     assert res.converged and res.stable
     assert res.residual_floor > 1e-9  # above the default rtol
     assert res.residual <= res.residual_floor
+
+
+def test_modes_are_kept_when_asked_and_are_node_fields():
+    n = 21
+    res = solve_static(
+        column(n),
+        Supports.clamp_ends(n),
+        Loads(forces=[(n - 1, (-0.5 * P_CR, 0.0, 0.0))]),
+        options=NewtonOptions(eigenvalues=2, keep_modes=True),
+    )
+    assert res.stable and res.modes is not None and res.modes.count == 2
+    assert res.modes.displacements.shape == (2, n, 3) and res.modes.twist.shape == (2, n - 1)
+    # the clamped first edge does not move; the tip moves most (first bending mode)
+    d = np.linalg.norm(res.modes.displacements[0], axis=1)
+    assert d[:2].max() == 0.0 and np.argmax(d) == n - 1
+    assert solve_static(column(n)).modes is None  # not kept by default
