@@ -242,6 +242,8 @@ class TubePanel:
         Per-segment scalar ``(E,)`` to colour by instead of the Janus sides, or ``None``.
     active_fraction
         Active area fraction, scalar or ``(E,)``.
+    view
+        Camera ``(elev, azim)`` (degrees) of this panel; default the figure's.
     """
 
     positions: FloatArray
@@ -252,6 +254,7 @@ class TubePanel:
     ghost: FloatArray | None = None
     values: FloatArray | None = None
     active_fraction: float | FloatArray = 0.5
+    view: tuple[float, float] | None = None
 
 
 def tube_extent(panels: Sequence[TubePanel]) -> tuple[list[FloatArray], FloatArray]:
@@ -392,7 +395,8 @@ def plot_tube_panels(
             base = np.tile(to_rgb(UNKNOWN_COLOUR), (len(quads), 1))
         else:
             base = np.where(active[:, None], to_rgb(ACTIVE_COLOUR), to_rgb(PASSIVE_COLOUR))
-        rgb = shade(base, fn, eye, light)
+        pe, pa = (elev, azim) if p.view is None else p.view
+        rgb = shade(base, fn, *(_view_vectors(pe, pa) if p.view is not None else (eye, light)))
         # edges in the face colour hide the hairline seams anti-aliasing leaves between facets
         poly = Poly3DCollection(quads, facecolors=rgb, edgecolors=rgb, linewidths=0.2, zorder=2)
         ax.add_collection3d(poly)
@@ -400,7 +404,7 @@ def plot_tube_panels(
         ax.set_ylim(c[1] - half[1], c[1] + half[1])
         ax.set_zlim(c[2] - half[2], c[2] + half[2])
         ax.set_box_aspect(tuple(half), zoom=0.94)
-        ax.view_init(elev=elev, azim=azim)
+        ax.view_init(elev=pe, azim=pa)
         ax.set_axis_off()
         # scale bar along x at the bottom front of the box
         x0 = c[0] - half[0] * 0.95

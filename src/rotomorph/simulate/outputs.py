@@ -370,8 +370,10 @@ def _movie(results: RunResults, verdicts: list[StepVerdict], path: Path) -> Path
     lattice = _kind(results) == "lattice"
 
     def panels(k: int) -> list[Any]:
-        if lattice:
-            return [_lattice_panel(results, k, "")]
+        if lattice:  # an oblique and a side view: a landscape frame that shows the height
+            p = _lattice_panel(results, k, "")
+            side = type(p)(**{**p.__dict__, "view": (4.0, -90.0), "title": "side view"})
+            return [p, side]
         return _filament_panels(results, k)
 
     # a box per panel that holds the panel in every frame, so nothing rescales
