@@ -58,7 +58,14 @@ from rotomorph.simulate.validation import (
     validate_filaments,
 )
 
-__all__ = ["PaperReport", "calibrated_model", "paper_report", "prediction_table"]
+__all__ = [
+    "PaperReport",
+    "calibrated_model",
+    "lattice_rows",
+    "paper_report",
+    "paper_rows",
+    "prediction_table",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -468,15 +475,25 @@ def paper_rows(*, quick: bool = False) -> tuple[list[dict[str, Any]], dict[str, 
         Exactly the rows of ``summary.json`` and :func:`summarise` of them.
     """
     val = validate_filaments()
-    lattice, _ = _lattice_section(
+    rows = _ordered(val, lattice_rows(quick=quick))
+    return rows, summarise(rows)
+
+
+def lattice_rows(*, quick: bool = False) -> list[dict[str, Any]]:
+    """The report's lattice rows (areas, jamming bound, signs) without figures.
+
+    Each lattice is heated through the model calibrated on all filament groups, every printed
+    line driven by its own print program; ``quick``: 3 × 3 lattices, 3 steps, no sd.
+    """
+    val = validate_filaments()
+    rows, _ = _lattice_section(
         val.calibrations["all"].chosen,
         None,
         quick=quick,
         steps=3 if quick else LATTICE_STEPS,
         tick=lambda: None,
     )
-    rows = _ordered(val, lattice)
-    return rows, summarise(rows)
+    return rows
 
 
 def _ordered(val: Validation, lattice: list[dict[str, Any]]) -> list[dict[str, Any]]:
