@@ -138,8 +138,13 @@ def _executor(executor: Any, scheduler: str | None, workers: int | None) -> Iter
         with client:
             yield client.get_executor()
         return
-    with local_executor(workers) as ex:
-        yield ex
+    pool = local_executor(workers)
+    try:
+        yield pool
+    except BaseException:  # Ctrl-C or an error: drop queued runs, stop the running ones
+        _terminate(pool)
+        raise
+    pool.shutdown(wait=True)
 
 
 def local_executor(workers: int | None = None) -> cf.ProcessPoolExecutor:
@@ -154,25 +159,57 @@ def local_executor(workers: int | None = None) -> cf.ProcessPoolExecutor:
         max_workers=workers or os.cpu_count() or 1,
         mp_context=_pool_context(),
         initializer=_warm_worker,
+        initargs=(os.getpid(),),
     )
 
 
 def _pool_context() -> Any:
-    """``fork`` (cheap: workers inherit the imports) while this process has one thread;
-    ``forkserver`` otherwise (forking a threaded process can deadlock)."""
+    """``forkserver`` (POSIX) or ``spawn``: workers start as clean processes that inherit no
+    locks, signal handlers or threads of the caller; the server has imported rotomorph once."""
     import multiprocessing
-    import threading
 
-    if threading.active_count() == 1 and "fork" in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("fork")
+    if "forkserver" not in multiprocessing.get_all_start_methods():  # pragma: no cover
+        return multiprocessing.get_context("spawn")
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload(["rotomorph.sweep.run"])
     return ctx
 
 
-def _warm_worker() -> None:
-    """Pool initializer: load the solver's kernels before the first run (see ``_warm``)."""
+def _warm_worker(owner: int) -> None:
+    """Pool initializer: Ctrl-C is the owner's to handle (it stops the pool), SIGTERM ends
+    the worker, the worker exits when the owner process (pid ``owner``) is gone, even killed
+    by SIGKILL; then the solver's kernels are loaded before the first run (see ``_warm``)."""
+    import signal
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+    def watch() -> None:
+        while True:
+            time.sleep(1.0)
+            try:
+                os.kill(owner, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:  # pragma: no cover - pid reused by another user
+                os._exit(1)
+
+    threading.Thread(target=watch, name="rotomorph-owner-watch", daemon=True).start()
     import rotomorph.sweep._warm  # noqa: F401
+
+
+def _terminate(pool: cf.ProcessPoolExecutor) -> None:
+    """Cancel queued runs and stop the workers now (their runs are not stored: a restart
+    computes them)."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    workers = list((getattr(pool, "_processes", None) or {}).values())  # before shutdown
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in workers:
+        proc.terminate()
 
 
 def _write_plan(store: RunStore, sweep: Sweep) -> None:

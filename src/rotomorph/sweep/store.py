@@ -6,7 +6,7 @@ Layout of a sweep folder ``DIR``::
     DIR/runs/<id[:2]>/<id>.json  one record per finished run (the completion marker)
     DIR/runs/<id[:2]>/<id>.h5    the run's full results (only with ``hdf5 = true``)
     DIR/results.parquet          the table (:mod:`rotomorph.sweep.table`)
-    DIR/.lock                    held (``flock``) while a sweep writes to DIR
+    DIR/.lock                    locked (``lockf``) while a sweep writes to DIR
 
 A run is *finished* exactly when its ``.json`` record exists. Records are written to a
 temporary file and renamed (:func:`rotomorph.io.atomic.atomic_write_text`), after the run's
@@ -58,9 +58,9 @@ class RunStore:
         import fcntl
 
         fh = open(self.folder / ".lock", "a+")
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+        try:  # a POSIX record lock: held by this process only, never by forked children
+            fcntl.lockf(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
             fh.close()
             raise InvalidParameterError(
                 "output", f"{self.folder}: another sweep is writing to this folder; wait for it"
