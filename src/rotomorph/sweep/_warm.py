@@ -1,4 +1,4 @@
-"""Imported by each worker of the local process pool before its first run: warms the kernels.
+"""Imported by the local pool's fork server (and each worker): warms the solver's kernels.
 
 Compiled (numba) kernels are loaded from their on-disk cache on first call, which costs about a
 second per process; paying it here keeps it out of the first run's wall time. A failure only

@@ -165,13 +165,14 @@ def local_executor(workers: int | None = None) -> cf.ProcessPoolExecutor:
 
 def _pool_context() -> Any:
     """``forkserver`` (POSIX) or ``spawn``: workers start as clean processes that inherit no
-    locks, signal handlers or threads of the caller; the server has imported rotomorph once."""
+    locks, signal handlers or threads of the caller; the server has imported rotomorph and
+    loaded the solver's kernels once, so every worker it forks starts warm."""
     import multiprocessing
 
     if "forkserver" not in multiprocessing.get_all_start_methods():  # pragma: no cover
         return multiprocessing.get_context("spawn")
     ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(["rotomorph.sweep.run"])
+    ctx.set_forkserver_preload(["rotomorph.sweep._warm"])  # kernels loaded once, forked warm
     return ctx
 
 
