@@ -140,3 +140,13 @@ def test_obstacle_constructors_check_units_and_shapes():
     assert cyl.start == (-10.0, 0.0, 1.0) and cyl.moved((0, 0, 1)).end == (10.0, 0.0, 2.0)
     assert Floor(normal=(0, 0, 2)).normal == (0.0, 0.0, 1.0)
     assert Sphere((0, 0, 0), 2.5).moved((1, 0, 0)).centre == (1.0, 0.0, 0.0)
+
+
+def test_bath_density_is_data_with_a_source():
+    from rotomorph.materials.bath import bath_density, bath_fluids
+
+    assert bath_density() == pytest.approx(0.97)
+    assert bath_density(temperature=175.0) == pytest.approx(0.97 / (1 + 0.00096 * 150))
+    assert "PMX-200" in bath_fluids()["silicone_oil"]["source"]
+    with pytest.raises(InvalidParameterError, match="known"):
+        bath_density("water")

@@ -102,6 +102,7 @@ def pair_barrier(
     ``x`` (M, 3); a point repeats its node (``p0 = p1`` for a node against a segment, ``q0 = q1``
     for a sphere's centre).
 
+    Inactive pairs with ``dist >= dmin + dhat`` leave ``hloc`` unwritten.
     ``mollify`` (P,): IPC's mollifier threshold ``eps`` of edge–edge pairs (0: none). The
     distance of two segments has a kink where they are parallel and overlap (the closest points
     jump along the overlap); the mollifier fades the edge–edge term out there, and node–segment
@@ -122,9 +123,9 @@ def pair_barrier(
         zhat = (2.0 * dmin[p] + dhat) * dhat
         b, b1, b2 = barrier(D - dmin[p] * dmin[p], zhat)
         if b == 0.0 and b1 == 0.0:
-            if need_hess:
+            if need_hess and dist[p] < dmin[p] + dhat:  # rounding at the activation edge
                 hloc[p] = 0.0
-            continue
+            continue  # inactive: its hloc block is left unwritten
         if not np.isfinite(b):
             return np.inf
         if need_hess:  # active pair: now its Hessian

@@ -397,7 +397,8 @@ class ContactPotential:
         xe = self._extended(x)
         grad = np.zeros_like(xe)
         P = len(cand.quads)
-        hloc = np.zeros((P, 12, 12)) if need_hess else np.zeros((0, 12, 12))
+        # only active pairs' blocks are written (and read back, by the distance test below)
+        hloc = np.empty((P, 12, 12)) if need_hess else np.empty((0, 12, 12))
         dist = np.empty(P)
         energy = pair_barrier(
             xe, cand.quads, cand.dmin, cand.weight, cand.mollify, self.dhat, self.kappa,
@@ -425,32 +426,31 @@ class ContactPotential:
                 grad += gf
             extra_quads, extra_h = self._lag.nodes, hf
         g = grad[: self.n_nodes] if need_grad else None
-        hess = self._triplets(cand, hloc, fl_h, extra_quads, extra_h) if need_hess else None
+        active = np.flatnonzero(dist < cand.dmin + self.dhat)
+        hess = (
+            self._triplets(cand.quads[active], hloc[active], cand, fl_h, extra_quads, extra_h)
+            if need_hess
+            else None
+        )
         return float(energy), g, hess
 
     def _triplets(
         self,
-        cand: _Candidates,
+        quads: IntArray,
         hloc: FloatArray,
+        cand: _Candidates,
         fl_h: FloatArray,
         extra_quads: IntArray | None = None,
         extra_h: FloatArray | None = None,
     ) -> tuple[IntArray, IntArray, FloatArray]:
         n3 = 3 * self.n_nodes
-        quads = cand.quads
         if extra_quads is not None and extra_h is not None and len(extra_quads):
             quads = np.concatenate([quads, extra_quads])
             hloc = np.concatenate([hloc, extra_h])
         dof = (quads[:, :, None] * 3 + np.arange(3)).reshape(-1, 12)
-        active = (
-            np.flatnonzero(np.abs(hloc).reshape(len(hloc), -1).max(axis=1) > 0)
-            if len(hloc)
-            else np.zeros(0, dtype=np.int64)
-        )
-        dof = dof[active]
         rows = np.repeat(dof, 12, axis=1).ravel()
         cols = np.tile(dof, (1, 12)).ravel()
-        vals = hloc[active].reshape(-1)
+        vals = hloc.reshape(-1)
         fdof = (cand.floor_nodes[:, None] * 3 + np.arange(3)).reshape(-1, 3)
         frows = np.repeat(fdof, 3, axis=1).ravel()
         fcols = np.tile(fdof, (1, 3)).ravel()

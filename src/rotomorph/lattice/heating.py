@@ -289,17 +289,24 @@ def _supports(lattice: Lattice, name: str) -> Supports:
 
 
 def lattice_gravity(
-    lattice: Lattice, *, fluid_density: float = 0.97, density: float | None = None
+    lattice: Lattice, *, fluid_density: float | None = None, density: float | None = None
 ) -> Gravity:
-    """Self-weight of a lattice's filaments with buoyancy (notes Q15), all layers lumped.
+    """Self-weight of a lattice's filaments with buoyancy, all layers lumped: the effective
+    line weight is (ρ_filament − ρ_bath) g A with A the lumped section.
 
     Parameters
     ----------
     fluid_density
-        Density of the bath (g/cm³); silicone oil ≈ 0.97.
+        Density of the bath (g/cm³); default the silicone oil of the bath-fluid table at
+        25 °C (:func:`rotomorph.materials.bath.bath_density`: 0.97, PDMS fluid data sheets;
+        ``bath_density(temperature=175)`` ≈ 0.83 for the hot bath).
     density
         Filament density (g/cm³); default the mean of the lattice's two inks (materials table).
     """
+    from rotomorph.materials.bath import bath_density
+
+    if fluid_density is None:
+        fluid_density = bath_density("silicone_oil")
     from rotomorph.materials.material import get_material
 
     if density is None:

@@ -36,6 +36,7 @@ from rotomorph.analysis.shape import (
     fit_helix,
     polyline_morphology,
 )
+from rotomorph.contact import Contact
 from rotomorph.errors import InvalidParameterError, RotomorphError
 from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.natural import FilamentModel, NaturalField, natural_field
@@ -260,6 +261,7 @@ def simulate_filament(
     options: NewtonOptions | None = None,
     max_refinements: int = 4,
     progress: Progress | None = None,
+    contact: Contact | None = None,
 ) -> FilamentSimulation:
     """Equilibrium shapes of a free filament heated from ``start_temperature`` to ``temperature``.
 
@@ -281,6 +283,9 @@ def simulate_filament(
         Times a failing step may be halved.
     progress
         Called with 1 after every step (for a progress bar).
+    contact
+        Self-contact (and obstacles) of the filament (:class:`rotomorph.contact.Contact`):
+        tight coils touch instead of passing through themselves.
 
     Raises
     ------
@@ -316,7 +321,9 @@ def simulate_filament(
         # field is linear in the actuation, stiffness does not depend on it)
         k = min(int(np.floor(w)), s - 2)
         field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
-        res = solve_static(rod_model(program, field), initial=initial, options=options)
+        res = solve_static(
+            rod_model(program, field), initial=initial, options=options, contact=contact
+        )
         iterations_at[w] = iterations_at.get(w, 0) + res.iterations
         if progress is not None and w == int(w):
             progress(1)
