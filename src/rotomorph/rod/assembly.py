@@ -20,7 +20,7 @@ from rotomorph.rod.kernels import _cross, _dot, _row, bend_twist_stencil, stretc
 _CACHE = True
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _transport(u, ta, tb):
     """Parallel transport of 3-tuple ``u`` from unit ``ta`` to unit ``tb`` (tuples)."""
     b = _cross(ta, tb)

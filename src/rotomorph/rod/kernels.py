@@ -33,38 +33,43 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+#: Compiled machine code is cached on disk (``__pycache__``): only the first run compiles.
+#: The small helpers below are *not* inlined by numba (``inline="always"``): inlining them at
+#: every call site made type inference of the stencil kernels about half of the whole first-run
+#: compile time, while LLVM still inlines them in the machine code (measured: first filament
+#: solve 30.6 s -> 19.4 s CPU cold; objective evaluation at N = 10 001 unchanged, 15-19 ms).
 _CACHE = True
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _lin(ca, a, cb, b):
     """ca * a + cb * b for 3-tuples."""
     return (ca * a[0] + cb * b[0], ca * a[1] + cb * b[1], ca * a[2] + cb * b[2])
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _row(arr, i):
     return (arr[i, 0], arr[i, 1], arr[i, 2])
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _clear(M, k):
     for i in range(3):
         for j in range(3):
             M[k, i, j] = 0.0
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _outer(M, k, c, a, b, sym):
     """M[k] += c * a b^T (+ c * b a^T when sym)."""
     for i in range(3):
@@ -75,7 +80,7 @@ def _outer(M, k, c, a, b, sym):
             M[k, i, j] += c * v
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _cross_matrix(M, k, c, a):
     """M[k] += c * [a]_x  (so that [a]_x v = a x v)."""
     M[k, 0, 1] -= c * a[2]
@@ -86,7 +91,7 @@ def _cross_matrix(M, k, c, a):
     M[k, 2, 1] += c * a[0]
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _identity(M, k, c):
     for i in range(3):
         M[k, i, i] += c
@@ -113,7 +118,7 @@ def _place_edge_blocks(H, w, D):
             H[8 + i, 8 + j] += w * ff
 
 
-@njit(cache=_CACHE, inline="always")
+@njit(cache=_CACHE)
 def _place_theta(H, w, col, De, Df):
     """H[x, col] and H[col, x] += w * mixed derivatives from d/de d/dtheta and d/df d/dtheta."""
     for i in range(3):
