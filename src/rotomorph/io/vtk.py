@@ -265,20 +265,10 @@ def write_vtp_series(
     pathlib.Path
         The ``.pvd`` path.
     """
-    pos = np.asarray(frames, dtype=float)
-    if pos.ndim != 3 or pos.shape[2] != 3:
-        raise InvalidParameterError("frames", f"must have shape (S, N, 3) in mm; got {pos.shape}")
-    steps = len(pos)
-    t = np.arange(steps, dtype=float) if times is None else np.asarray(times, dtype=float)
-    if t.shape != (steps,):
-        raise InvalidParameterError("times", f"must have one value per frame ({steps})")
-    data = {k: np.asarray(v) for k, v in (point_data or {}).items()}
-    for k, v in data.items():
-        if v.shape[:1] != (steps,):
-            raise InvalidParameterError(f"point_data[{k!r}]", f"needs a leading axis of {steps}")
+    pos, t, (data,) = _series(frames, times, point_data=point_data)
     target = Path(path)
     entries = []
-    for s in range(steps):
+    for s in range(len(pos)):
         name = f"{target.stem}_{s:04d}.vtp"
         write_vtp(
             target.parent / name,
@@ -289,6 +279,27 @@ def write_vtp_series(
         )
         entries.append((float(t[s]), name))
     return write_pvd(target, entries)
+
+
+def _series(
+    frames: FloatArray, times: Sequence[float] | None, **arrays: Mapping[str, object] | None
+) -> tuple[FloatArray, FloatArray, list[dict[str, np.ndarray]]]:
+    """Checked positions ``(S, N, 3)``, times ``(S,)`` and per-step data arrays by kind."""
+    pos = np.asarray(frames, dtype=float)
+    if pos.ndim != 3 or pos.shape[2] != 3:
+        raise InvalidParameterError("frames", f"must have shape (S, N, 3) in mm; got {pos.shape}")
+    steps = len(pos)
+    t = np.arange(steps, dtype=float) if times is None else np.asarray(times, dtype=float)
+    if t.shape != (steps,):
+        raise InvalidParameterError("times", f"must have one value per frame ({steps})")
+    out = []
+    for what, given in arrays.items():
+        data = {k: np.asarray(v) for k, v in (given or {}).items()}
+        for k, v in data.items():
+            if v.shape[:1] != (steps,):
+                raise InvalidParameterError(f"{what}[{k!r}]", f"needs a leading axis of {steps}")
+        out.append(data)
+    return pos, t, out
 
 
 def write_vtu(
@@ -374,22 +385,10 @@ def write_vtu_series(
     Parameters are those of :func:`write_vtp_series`; ``cell_data`` arrays are ``(S, E)`` or
     ``(S, E, k)``. Returns the ``.pvd`` path.
     """
-    pos = np.asarray(frames, dtype=float)
-    if pos.ndim != 3 or pos.shape[2] != 3:
-        raise InvalidParameterError("frames", f"must have shape (S, N, 3) in mm; got {pos.shape}")
-    steps = len(pos)
-    t = np.arange(steps, dtype=float) if times is None else np.asarray(times, dtype=float)
-    if t.shape != (steps,):
-        raise InvalidParameterError("times", f"must have one value per frame ({steps})")
-    pdata = {k: np.asarray(v) for k, v in (point_data or {}).items()}
-    cdata = {k: np.asarray(v) for k, v in (cell_data or {}).items()}
-    for what, data in (("point_data", pdata), ("cell_data", cdata)):
-        for k, v in data.items():
-            if v.shape[:1] != (steps,):
-                raise InvalidParameterError(f"{what}[{k!r}]", f"needs a leading axis of {steps}")
+    pos, t, (pdata, cdata) = _series(frames, times, point_data=point_data, cell_data=cell_data)
     target = Path(path)
     entries = []
-    for s in range(steps):
+    for s in range(len(pos)):
         name = f"{target.stem}_{s:04d}.vtu"
         write_vtu(
             target.parent / name,
