@@ -47,6 +47,7 @@ import numpy as np
 from rotomorph._typing import FloatArray
 from rotomorph.materials.calibrate import (
     CALIBRATION_GROUPS,
+    FIT_RESOLUTION,
     paper_calibration,
     predict,
 )
@@ -256,7 +257,9 @@ def _closed_form_rows(group: str, fit: Fit, full: Fit) -> list[dict[str, Any]]:
     def at(res: int) -> Callable[[Any], FloatArray]:
         return lambda m: predict(group, table.x, dataclasses.replace(m, resolution=res))
 
-    value, sd = fit.propagate(at(lo))
+    # sensitivities on the fit's mesh (their discretisation error is far below the sd)
+    _, sd = fit.propagate(at(FIT_RESOLUTION))
+    value = at(lo)(fit.model)
     fine = at(hi)(fit.model)
     in_sample = at(lo)(full.model)
     labels = {
@@ -355,7 +358,8 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
             def ratio(m: FilamentModel, s: str = side, f: float = flip) -> FloatArray:
                 return np.array([sinusoid_ratio(s, at_resolution(m), lo, f)])
 
-            _, sd = full.propagate(ratio)
+            # the printable variant is shown, not counted: no uncertainty propagated for it
+            sd = full.propagate(ratio)[1] if flip == IDEAL_FLIP else np.array([np.nan])
             res = at_two_resolutions(
                 lambda h, s=side, f=flip: sinusoid_ratio(s, model, h, f),  # type: ignore[misc]
                 lo,
@@ -379,7 +383,7 @@ def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
                     float(table.value[i]),
                     float(table.spread[i]),
                     res.value,
-                    predicted_sd=float(sd[0]),
+                    predicted_sd=float(sd[0]) if np.isfinite(sd[0]) else None,
                     counted=None if ideal else False,
                     other=res.coarse,
                     disc_error=res.error,
