@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 import numpy as np
 import tomli_w
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     ConfigDict,
@@ -146,6 +147,7 @@ class _Model(BaseModel):
 
 
 def _check_material(name: str, kind: str) -> str:
+    """``name`` if it is a registered material of ``kind`` ("active" or "passive")."""
     try:
         mat = get_material(name)
     except MaterialError:
@@ -156,6 +158,18 @@ def _check_material(name: str, kind: str) -> str:
         article = "an" if kind == "active" else "a"
         raise ValueError(f"{name!r} is a {mat.kind} material; give {article} {kind} one")
     return name
+
+
+ActiveMaterial = Annotated[
+    str,
+    Field(min_length=1, max_length=100),
+    AfterValidator(lambda name: _check_material(name, "active")),
+]
+PassiveMaterial = Annotated[
+    str,
+    Field(min_length=1, max_length=100),
+    AfterValidator(lambda name: _check_material(name, "passive")),
+]
 
 
 class _Control(_Model):
@@ -262,26 +276,12 @@ class Filament(_Control, _Process):
     spacing: float = _ranged("vertex_spacing", 0.1, "rod vertex spacing")
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: str = Field(
-        "lce", min_length=1, max_length=100, description="registered active material"
-    )
-    passive_material: str = Field(
-        "acrylate", min_length=1, max_length=100, description="registered passive material"
-    )
+    active_material: ActiveMaterial = Field("lce", description="registered active material")
+    passive_material: PassiveMaterial = Field("acrylate", description="registered passive material")
     layer: int = _ranged("layer", 0, "printed layer")
     segments: list[SegmentModel] = Field(
         min_length=1, max_length=MAX_NODES, description="the path, segment by segment"
     )
-
-    @field_validator("active_material")
-    @classmethod
-    def _active_known(cls, name: str) -> str:
-        return _check_material(name, "active")
-
-    @field_validator("passive_material")
-    @classmethod
-    def _passive_known(cls, name: str) -> str:
-        return _check_material(name, "passive")
 
     @model_validator(mode="after")
     def _rotation_rate(self) -> Filament:
@@ -428,12 +428,8 @@ class LatticeModel(_Process):
     speed: Speed = 3.0
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: str = Field(
-        "lce", min_length=1, max_length=100, description="registered active material"
-    )
-    passive_material: str = Field(
-        "acrylate", min_length=1, max_length=100, description="registered passive material"
-    )
+    active_material: ActiveMaterial = Field("lce", description="registered active material")
+    passive_material: PassiveMaterial = Field("acrylate", description="registered passive material")
     origin: Vec3 = Field((0.0, 0.0, 0.0), description="where the lattice is printed (mm)")
     flip_length: float = Field(
         0.0,
@@ -441,16 +437,6 @@ class LatticeModel(_Process):
         le=LIMITS["extent"].maximum,
         description="arc length (mm) of each pi flip of the active side (0: a step)",
     )
-
-    @field_validator("active_material")
-    @classmethod
-    def _active_known(cls, name: str) -> str:
-        return _check_material(name, "active")
-
-    @field_validator("passive_material")
-    @classmethod
-    def _passive_known(cls, name: str) -> str:
-        return _check_material(name, "passive")
 
     @model_validator(mode="after")
     def _size(self) -> LatticeModel:
