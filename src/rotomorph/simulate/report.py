@@ -259,9 +259,15 @@ SD_STEPS = 4
 
 
 def _heat(
-    pattern: str, quick: bool, steps: int, model: FilamentModel, ghosts: int
+    pattern: str,
+    quick: bool,
+    steps: int,
+    model: FilamentModel,
+    ghosts: int,
+    contact: bool = False,
 ) -> tuple[Any, Any, str]:
-    """(lattice, HeatingResult or None, reason): heated through the materials chain."""
+    """(lattice, HeatingResult or None, reason): heated through the materials chain;
+    ``contact``: with self-contact, resting on the bath floor under its buoyant weight."""
     try:
         from rotomorph.lattice import actuation as modes
         from rotomorph.lattice.heating import heat_lattice
@@ -276,9 +282,16 @@ def _heat(
     lattice = sinusoidal_lattice(n, 5.0, 1.25, ghosts, pattern)  # type: ignore[arg-type]
     try:
         actuation = mode(filament_model=model)
-        key = repr((pattern, n, ghosts, steps, actuation))
+        key = repr((pattern, n, ghosts, steps, actuation) + (("bath floor",) if contact else ()))
+        extra: dict[str, Any] = {}
+        if contact:
+            from rotomorph.lattice.heating import lattice_gravity
+
+            extra = {"floor": True, "gravity": lattice_gravity(lattice)}
         result = disk_cached(
-            "heat_lattice", key, lambda: heat_lattice(lattice, actuation=actuation, steps=steps)
+            "heat_lattice",
+            key,
+            lambda: heat_lattice(lattice, actuation=actuation, steps=steps, **extra),
         )
         return lattice, result, ""
     except RotomorphError as err:
@@ -323,6 +336,18 @@ def _lattice_section(
         if pattern in ("expanding", "contracting"):
             fine[pattern] = _heat(pattern, quick, steps, model, fine_g)[1]
         tick()
+    # contact-resolved ramps: self-contact, resting on the bath floor under buoyant weight
+    # (the expanding lattice never comes within a diameter: it needs none)
+    # (left out in quick mode, whose 3 x 3 smoke run must stay fast: signs then come from the
+    # ramps without contact and say so)
+    resolved = (
+        {}
+        if quick
+        else {
+            p: _heat(p, quick, steps, model, coarse_g, contact=True)
+            for p in ("contracting", "dome", "saddle")
+        }
+    )
     # Fig. 3G: area
     fig = new_figure(6.0, 4.2)
     ax = fig.add_subplot()
@@ -351,32 +376,34 @@ def _lattice_section(
                 f"through the calibrated materials chain ('{res.actuation}'); sd by one-sided "
                 f"secants at {coarse_g} ghost nodes (none in quick mode); measured A/A0 = 1 + "
                 "change (%)/100; "
-                f"contact not modelled (min clearance {np.min(res.min_clearance):.2f} "
-                "diameters)",
+                f"no contact in this row (min clearance {np.min(res.min_clearance):.2f} "
+                "diameters; the contact-resolved value is the next row where they touch)",
             )
         )
-        if res is not None and pattern == "contracting":
-            k = res.last_contact_free()
+        touched = resolved.get(pattern, (None, None, ""))[1]
+        if touched is not None:
             rows.append(
                 _row(
                     "lattice_area_ratio",
-                    f"{table.condition[i]}, at first self-contact (jamming bound)",
+                    f"{table.condition[i]}, contact-resolved on the bath floor",
                     measured,
                     spread,
-                    float(res.area_ratio[k]),
+                    float(touched.final_area_ratio),
                     counted=False,
                     unit="1",
                     figure="fig3g_lattice_area.png",
-                    note=f"{size}; last ramp step (x = {res.parameter[k]:.2f}) before "
-                    "neighbouring filaments come within one diameter: contact, which the "
-                    "paper says jams the contracting lattice, would stop contraction here",
+                    note=f"{size}; self-contact (centre lines never closer than a diameter: "
+                    f"min clearance {np.min(touched.min_clearance):.3f}) and the bath floor "
+                    f"under buoyant weight; {int(touched.contacts_active[-1])} contacts at "
+                    f"{touched.parameter[-1]:.0f} °C; largest rise off the floor "
+                    f"{float(touched.floor_lift[-1]):.2f} mm",
                 )
             )
         if res is not None:
-            ax.plot(res.parameter, res.area_ratio, "o-", ms=3, label=f"{pattern} (model)")
-            k = res.last_contact_free()
-            if k < len(res.parameter) - 1:
-                ax.axvline(res.parameter[k], color="0.6", ls=":", lw=1)
+            ax.plot(res.parameter, res.area_ratio, "o-", ms=3, label=f"{pattern} (no contact)")
+        if touched is not None:
+            ax.plot(touched.parameter, touched.area_ratio, "s-", ms=3,
+                    label=f"{pattern} (contact, on the floor)")  # fmt: skip
         x_end = 0.75 if res is None else float(res.parameter[-1])
         ax.errorbar([x_end], [measured], yerr=[spread], fmt="s", capsize=3,
                     label=f"{pattern} (measured, 175 °C)")  # fmt: skip
@@ -387,36 +414,36 @@ def _lattice_section(
     ax.legend(fontsize=7)
     if figs is not None:
         paths.append(save_figure(fig, figs / "fig3g_lattice_area.png"))
-    # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i, at the last contact-free step
-    # (what the elastic model can claim) and, where later, at the end of the ramp
+    # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i at the end of the ramp,
+    # contact-resolved where filaments touch
     for pattern in ("expanding", "contracting", "dome", "saddle"):
-        lattice, res, _ = results[pattern]
+        lattice, res, _ = resolved.get(pattern, results[pattern])
         if res is None or figs is None:
             continue
-        k_free, k_end = res.last_contact_free(), len(res.parameter) - 1
-        for k, suffix in ((k_free, ""), (k_end, "_final")):
-            if suffix and k == k_free:
-                continue
-            rel = network_relative_curvature_change(
-                res.positions[k], res.positions[0], lattice.edge_chains
-            )
-            state = "before self-contact" if not suffix else "self-intersecting, no contact model"
-            f = plot_lattice_views(
-                res.positions[k],
-                lattice.network.edges,
-                rel,
-                label="(κ − κ_i)/κ_i",
-                title=f"{pattern}, ramp {res.parameter[k]:.3g} ({state})",
-            )
-            paths.append(save_figure(f, figs / f"lattice_{pattern}_views{suffix}.png"))
+        k = len(res.parameter) - 1
+        rel = network_relative_curvature_change(
+            res.positions[k], res.positions[0], lattice.edge_chains
+        )
+        state = (
+            "contact-resolved, on the bath floor"
+            if res.contact is not None
+            else f"no contact needed: clearance {np.min(res.min_clearance):.2f} diameters"
+        )
+        f = plot_lattice_views(
+            res.positions[k],
+            lattice.network.edges,
+            rel,
+            label="(κ − κ_i)/κ_i",
+            title=f"{pattern}, ramp {res.parameter[k]:.3g} ({state})",
+        )
+        paths.append(save_figure(f, figs / f"lattice_{pattern}_views.png"))
     # Fig. 4C/F: sign and characteristic curvature vs strain
     fig = new_figure(10.0, 4.0)
     axes = fig.subplots(1, 2)
     for ax, (pattern, sign, panel) in zip(
         axes, (("dome", 1, "4C"), ("saddle", -1, "4F")), strict=True
     ):
-        lattice, res, why = results[pattern]
-        k = -1 if res is None else res.last_contact_free()
+        lattice, res, why = resolved.get(pattern, results[pattern])
         rows.append(
             _row(
                 "lattice_gaussian_sign",
@@ -430,8 +457,15 @@ def _lattice_section(
                 figure="fig4cf_characteristic_curvature.png",
                 note=why
                 or f"{size}; sign of the fitted Gaussian curvature of the branch nodes at the "
-                f"end of the ramp ({res.parameter[-1]:.4g}); at the last contact-free step "
-                f"({res.parameter[k]:.4g}): {int(res.gaussian_sign[k]):+d}",
+                f"end of the ramp ({res.parameter[-1]:.4g}), "
+                + (
+                    "contact-resolved on the bath floor under buoyant weight (min clearance "
+                    f"{np.min(res.min_clearance):.3f}); first rises one diameter off the floor "
+                    f"at {res.first_lift_off()}"
+                    if res.contact is not None
+                    else "quick mode: no contact (min clearance "
+                    f"{np.min(res.min_clearance):.2f} diameters)"
+                ),
             )
         )
         rows.append(
@@ -480,7 +514,7 @@ def paper_rows(*, quick: bool = False) -> tuple[list[dict[str, Any]], dict[str, 
 
 
 def lattice_rows(*, quick: bool = False) -> list[dict[str, Any]]:
-    """The report's lattice rows (areas, jamming bound, signs) without figures.
+    """The report's lattice rows (areas, contact-resolved areas, signs) without figures.
 
     Each lattice is heated through the model calibrated on all filament groups, every printed
     line driven by its own print program; ``quick``: 3 × 3 lattices, 3 steps, no sd.
@@ -617,9 +651,10 @@ def _markdown(
             lines += ["![shapes](figures/fig2fg_shapes.png)", ""]
         if quantities[0] == "lattice_gaussian_sign":
             lines += [
-                "Views at the last ramp step before neighbouring filaments touch (the elastic "
-                "model without contact is valid up to there), then, where the ramp went on, "
-                "its end, where filaments pass through each other.",
+                "Views at the end of the ramp: contracting lattices, domes and saddles with "
+                "self-contact, resting on the bath floor under their buoyant weight "
+                "(filaments never pass through each other); the expanding lattice, whose "
+                "filaments never come within a diameter, without.",
                 "",
             ]
             for pattern in ("expanding", "contracting", "dome", "saddle"):
