@@ -15,8 +15,8 @@ uncertainty propagated to the prediction; ``z`` uses the combined spread
 √(spread² + predicted_sd²); ``calibration`` is true only for inputs (order parameters, passive
 free length) and ``converged`` compares two resolutions (1 % tolerance).
 
-Run: ``python examples/filaments_vs_paper.py``. The last line is the summary
-(``{"summary": ...}``). The same rows, plus lattices, are in ``rotomorph paper``'s summary.json.
+Run: ``python examples/filaments_vs_paper.py``: rows on stdout, the score line on stderr. The
+same rows, plus lattices, are in ``rotomorph paper``'s summary.json.
 """
 
 from __future__ import annotations
@@ -34,13 +34,12 @@ def rows() -> list[dict[str, Any]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Print one JSON object per line to stdout, then the summary line."""
+    """Print one JSON object per measured quantity to stdout and the score line to stderr."""
     del argv
     out = rows()
     for row in out:
         sys.stdout.write(json.dumps(row) + "\n")
-    summary = summarise(out)
-    sys.stdout.write(json.dumps({"summary": summary, "line": summary_line(summary)}) + "\n")
+    sys.stderr.write(summary_line(summarise(out)) + "\n")
     return 0
 
 

@@ -36,8 +36,8 @@ def test_example_rows_and_json_lines() -> None:
     buf = io.StringIO()
     with redirect_stdout(buf):
         assert mod.main([]) == 0
-    lines = [json.loads(line) for line in buf.getvalue().splitlines()]
-    rows, summary = lines[:-1], lines[-1]["summary"]
+    rows = [json.loads(line) for line in buf.getvalue().splitlines()]
+    summary = mod.summarise(rows)
     assert all(KEYS <= set(r) for r in rows)
     assert all(isinstance(r["converged"], bool) for r in rows)
     # one row per measured filament quantity
