@@ -298,3 +298,9 @@ def test_bad_machine_profiles(tmp_path, text, match):
     path.write_bytes("[machine]\nname = 'Fräse'\n".encode("latin-1"))
     with pytest.raises(InvalidParameterError, match="not UTF-8"):
         load_machine_profile(path)
+
+
+def test_keys_with_control_characters_give_one_line_errors():
+    with pytest.raises(InvalidDesignError) as info:
+        parse_design({"schema_version": 1, "lattice": {"a\nb\x00": 1}})
+    assert "\n" not in str(info.value) and "a\\nb\\x00" in info.value.field

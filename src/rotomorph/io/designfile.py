@@ -573,6 +573,11 @@ _TYPE_ERRORS: Final = {
 }
 
 
+def _printable(text: str) -> str:
+    """``text`` with control characters escaped (a key may hold a newline; errors are one line)."""
+    return text if text.isprintable() else text.encode("unicode_escape").decode("ascii")
+
+
 def _format_error(err: ErrorDetails) -> tuple[str, str]:
     loc: list[str] = []
     for part in err["loc"]:
@@ -581,7 +586,7 @@ def _format_error(err: ErrorDetails) -> tuple[str, str]:
         elif part in ("line", "arc", "sinusoid", "polyline") and loc and loc[-1].startswith("["):
             continue  # discriminator tag of a segment
         else:
-            loc.append(("." if loc else "") + str(part))
+            loc.append(("." if loc else "") + _printable(str(part)))
     field = "".join(loc) or "<design>"
     names = [str(part) for part in err["loc"] if isinstance(part, str)]
     unit = _UNITS.get(names[-1] if names else "", "")
