@@ -113,3 +113,37 @@ def test_lattice_sweep_reports_the_runs_verdict(tmp_path):
             assert r["physical"] is False and "pass through" in r["physical_reason"]
         else:
             assert r["physical"] is not False
+
+
+def test_cli_on_a_dask_scheduler_address(tmp_path, capsys):
+    import pytest
+
+    distributed = pytest.importorskip("distributed")
+    from rotomorph.cli import main
+    from rotomorph.sweep import read_table
+
+    path = tmp_path / "cf.toml"
+    path.write_text(
+        'schema_version = 1\noutputs = ["end_to_end_ratio", "morphology"]\n'
+        "[design]\nschema_version = 1\n[[design.filaments]]\nspacing = 0.1\n"
+        'segments = [{kind = "line", length = 8.0}]\n'
+        '[settings]\nmethod = "closed_form"\n'
+        '[[parameters]]\npath = "filaments[0].rotation_number"\nvalues = [0.06, 0.25, 1.0]\n'
+    )
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster:
+        code = main(
+            [
+                "sweep",
+                str(path),
+                "-o",
+                str(tmp_path / "out"),
+                "--scheduler",
+                cluster.scheduler_address,
+            ]
+        )
+    assert code == 0, capsys.readouterr().err
+    assert "3 ok" in capsys.readouterr().out
+    rows = read_table(tmp_path / "out").to_pylist()
+    assert [r["morphology"] for r in rows] == ["coil", "coil", "helix"]
