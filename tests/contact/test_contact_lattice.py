@@ -29,3 +29,15 @@ def test_gravity_on_a_free_lattice_needs_a_floor():
         heat_lattice(lat, steps=1, gravity=lattice_gravity(lat))
     with pytest.raises(InvalidParameterError, match="friction"):
         heat_lattice(lat, steps=1, friction=0.3)
+
+
+def test_floor_friction_holds_the_lattice_back():
+    """Lagged Coulomb friction with the floor (μ = 0.5): the lattice slides less in the first
+    step than on a frictionless floor, and still never interpenetrates."""
+    lat = sinusoidal_lattice(n=3, pattern="contracting")
+    kw = dict(steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
+    slick = heat_lattice(lat, **kw)
+    rough = heat_lattice(lat, friction=0.5, **kw)
+    assert rough.contact is not None and rough.contact.friction == 0.5
+    assert abs(1 - rough.area_ratio[1]) < 0.5 * abs(1 - slick.area_ratio[1])
+    assert rough.min_clearance.min() >= 1.0

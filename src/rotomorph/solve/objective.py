@@ -128,6 +128,9 @@ class RodObjective:
             if contact is None or contact.floor is None or contact.friction > 0
             else contact.floor
         )
+        # with friction the floor holds a free body in every direction wherever it touches:
+        # no rigid motion is free
+        self._held = contact is not None and contact.floor is not None and contact.friction > 0
         self.set_base(state)
         self._setup_scales(loads)
         if contact is not None:
@@ -432,7 +435,7 @@ class RodObjective:
         any component a factorization puts along them is round-off. With any support the step
         is returned unchanged (the remaining modes are handled by the shift).
         """
-        if not self._free_body:
+        if not self._free_body or self._held:
             return d
         du = np.zeros(self.model.layout.count)
         du[self.free] = d
@@ -567,7 +570,7 @@ class RodObjective:
         angle of edge ``j`` (the material frame turns with the body). These are the exact
         zero-energy directions the stability test removes.
         """
-        if not self._free_body:
+        if not self._free_body or self._held:
             return np.zeros((len(self.free), 0))
         lay = self.model.layout
         if self._floor_normal is not None:  # on a floor only the motions along it are free
