@@ -90,6 +90,8 @@ def test_filament_rests_on_floor_with_reaction_equal_to_buoyant_weight():
     weight = float((gravity.line_weight(len(lengths)) * lengths).sum())
     reaction = res.contact.forces(res.positions).sum(axis=0)
     assert reaction[2] == pytest.approx(weight, rel=1e-6)
+    (on_floor,) = res.contact.obstacle_forces(res.positions)
+    assert on_floor == pytest.approx(-reaction, rel=1e-9, abs=1e-15)
     assert np.allclose(reaction[:2], 0.0)
     heights = res.positions[:, 2] - R
     assert np.all(heights > 0) and np.all(heights < res.contact.dhat)
@@ -150,3 +152,22 @@ def test_bath_density_is_data_with_a_source():
     assert "PMX-200" in bath_fluids()["silicone_oil"]["source"]
     with pytest.raises(InvalidParameterError, match="known"):
         bath_density("water")
+
+
+def test_rod_pressed_on_a_cylinder_obstacle_feels_the_load():
+    """The beam of the crossing-rod test pushed onto a fixed Cylinder obstacle instead: the force
+    on the obstacle balances the load minus the beam's spring force."""
+    model, _, loads, closing, nb = _beam_on_rod(3.0)
+    beam = Model(
+        Network(model.network.nodes[:nb], model.network.edges[: nb - 1]),
+        *(np.asarray(getattr(model, k))[: nb - 1] for k in (
+            "bending_stiffness1", "bending_stiffness2", "twist_stiffness", "axial_stiffness"
+        )),
+    )  # fmt: skip
+    rod = Cylinder.along((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), radius=R, length=10.0)
+    contact = Contact(radius=R, obstacles=(rod,), activation_distance=2e-3)
+    res = solve_static(
+        beam, Supports(pinned_nodes=(0, nb - 1), fixed_twist_edges=(0,)), loads, contact=contact
+    )
+    (force,) = res.contact.obstacle_forces(res.positions)
+    assert -force[2] == pytest.approx(2.0 * closing, rel=0.02)

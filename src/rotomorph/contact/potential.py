@@ -493,6 +493,40 @@ class ContactPotential:
             raise InfeasibleContactError("positions", "filaments touch or interpenetrate")
         return -g
 
+    def obstacle_forces(self, x: FloatArray) -> list[FloatArray]:
+        """Resultant contact force on each obstacle ``(3,)`` (N), in ``contact.obstacles`` order
+        (e.g. the force a gripper's lattice exerts on each rod). Friction is not included."""
+        x = np.ascontiguousarray(x, dtype=float)
+        cand = self.candidates(x)
+        xe = self._extended(x)
+        n = self.n_nodes
+        out: list[FloatArray] = []
+        round_k = floor_k = 0
+        for o in self.contact.obstacles:
+            grad = np.zeros_like(xe)
+            if isinstance(o, Floor):
+                nodes, dmin, weight = cand.floors[floor_k]
+                floor_k += 1
+                e = plane_barrier(
+                    xe, nodes, np.asarray(o.normal), o.height, dmin, weight, self.dhat,
+                    self.kappa, True, 0, grad, np.zeros((0, 3, 3)), np.empty(len(nodes)),
+                )  # fmt: skip
+                force = grad[:n].sum(axis=0)  # minus the force the floor exerts on the nodes
+            else:
+                q = n + 2 * round_k
+                round_k += 1
+                mine = np.flatnonzero(cand.quads[:, 2] == q)
+                e = pair_barrier(
+                    xe, np.ascontiguousarray(cand.quads[mine]), cand.dmin[mine],
+                    cand.weight[mine], cand.mollify[mine], self.dhat, self.kappa, True, 0,
+                    grad, np.zeros((0, 12, 12)), np.empty(len(mine)),
+                )  # fmt: skip
+                force = -(grad[q] + grad[q + 1])
+            if not np.isfinite(e):
+                raise InfeasibleContactError("positions", "a filament touches an obstacle")
+            out.append(force)
+        return out
+
     def distances(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Centre-line distances of the candidate pairs near contact and their contact
         distances ``r_a + r_b`` (mm); floors as node heights and radii."""
