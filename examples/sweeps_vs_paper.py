@@ -1,4 +1,7 @@
-"""The paper's parameter sweeps, computed with rotomorph's sweep runner, next to its measurements.
+"""The paper's parameter sweeps
+==============================
+
+Computed with rotomorph's sweep runner, next to its measurements.
 
 Three sweep files in ``examples/sweeps/`` (each also runs with ``rotomorph sweep FILE -o DIR``):
 

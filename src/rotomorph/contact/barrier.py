@@ -162,7 +162,7 @@ def pair_barrier(
 def plane_barrier(
     x, nodes, normal, offset, dmin, weight, dhat, kappa, need_grad, need_hess, grad, hloc, dist
 ):  # pragma: no cover - compiled
-    """Barrier of nodes ``nodes`` (K,) above the plane ``normal . x = offset``.
+    """Barrier of nodes ``nodes`` (K,) above the plane ``normal·x = offset``.
 
     The signed height ``h = normal . x - offset`` must exceed ``dmin`` (the radius): the barrier
     is taken on ``h^2 - dmin^2`` (inf when ``h <= dmin``, also below the plane). Local Hessians

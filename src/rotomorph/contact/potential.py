@@ -40,7 +40,7 @@ ACTIVATION_FORCE = 1.0
 #: conservative-advancement sub-steps per pair before a step counts as not provably free
 #: (a pair sliding a distance L at gap g needs about L / (0.9 g) of them)
 MAX_SUBSTEPS = 100_000
-#: IPC's edge-edge mollifier threshold relative to |a|^2 |b|^2 (sin^2 of about 1.8 degrees)
+#: IPC's edge-edge mollifier threshold relative to ``|a|^2 |b|^2`` (sin² of about 1.8 degrees)
 MOLLIFIER = 1e-3
 #: default activation distance relative to the smallest contact distance
 DEFAULT_ACTIVATION = 0.01

@@ -9,11 +9,12 @@ edge by edge, exactly for the discrete strains of :func:`rotomorph.geometry.pair
 with k_b = 2 t_e × t_f/(1 + t_e·t_f) the curvature binormal and m1, m2 the material directors,
 κ1 = ½ k_b·(m2_e + m2_f), κ2 = −½ k_b·(m1_e + m1_f), and m1_f the parallel transport of m1_e
 turned by the twist τ about t_f. Writing k_b = a1 m1_e + a2 m2_e (k_b ⟂ t_e), parallel
-transport keeps k_b, so
+transport keeps k_b, so::
 
     2 κ1 = (1 + cos τ) a2 − sin τ a1,   2 κ2 = −(1 + cos τ) a1 − sin τ a2,
 
-a linear 2 × 2 system (determinant 2 + 2 cos τ > 0 for |τ| < π). Then |k_b| = 2 tan(β/2) gives
+a linear 2 × 2 system (determinant 2 + 2 cos τ > 0 for abs(τ) < π). Then the norm of k_b,
+2 tan(β/2), gives
 the turning angle β about k_b, and the next edge has the natural (rest) length.
 
 This is the state the Newton solver of :func:`rotomorph.simulate.filament.simulate_filament`

@@ -162,7 +162,7 @@ def tangent_rigid_modes(
     ndof: int,
 ) -> FloatArray:
     """Rigid motions tangent to a plane of ``normal``: two translations and the rotation
-    about the normal through the centroid (with its twist part ``n . t``), ``(3, ndof)``."""
+    about the normal through the centroid (with its twist part ``n·t``), ``(3, ndof)``."""
     n = np.asarray(normal, float) / np.linalg.norm(normal)
     a = np.cross(n, [1.0, 0.0, 0.0])
     if np.linalg.norm(a) < 0.5:
