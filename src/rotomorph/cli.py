@@ -294,6 +294,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from rotomorph.materials.natural import named_model
     from rotomorph.simulate.design import simulate_design, step_count
     from rotomorph.simulate.options import check_run_options
     from rotomorph.simulate.outputs import run_line, write_run_results
@@ -306,6 +307,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         "temperature": args.temperature,
         "spacing": args.spacing,
         "actuation": args.actuation,
+        "model": None if args.model is None else named_model(args.model),
     }
     try:  # before any output folder exists; named as the user typed them
         check_run_options("lattice" if design.lattice else "filaments", **options)
@@ -321,6 +323,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                 temperature=args.temperature,
                 spacing=args.spacing,
                 actuation=args.actuation,
+                model=options["model"],
                 progress=bar.update,
             )
         logging.getLogger("rotomorph.progress").info("writing results, figures and movie")
@@ -472,6 +475,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--start-temperature", type=float, help="print temperature (°C, filaments; default 25)"
     )
     p.add_argument("--spacing", type=float, help="filament vertex spacing override (mm)")
+    p.add_argument(
+        "--model",
+        choices=("calibrated", "warner-terentjev", "room-temperature"),
+        help="filament materials model (filaments; default calibrated, the one 'paper' uses)",
+    )
     p.add_argument(
         "--actuation",
         choices=("program", "thermal", "literal", "swapped", "radius", "additive"),

@@ -9,13 +9,14 @@ import numpy as np
 import pytest
 
 from rotomorph import geometry
-from rotomorph.errors import InvalidDesignError, MaterialError
+from rotomorph.errors import InvalidDesignError, InvalidParameterError, MaterialError
 from rotomorph.materials import FilamentModel, NaturalField, filament_section, natural_field
 from rotomorph.materials.calibrate import filament_shapes
 from rotomorph.materials.closed_form import janus_curvature
 
 R = 0.3
-MODEL = FilamentModel(resolution=64)
+# full-actuation moduli and x(T)-scaled eigenstrains: the exact relations checked below
+MODEL = FilamentModel(resolution=64, temperature_dependent=False)
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,7 @@ def test_straight_janus_without_rotation() -> None:
     nf = natural_field(prog, temperature=175.0, model=MODEL)
     assert isinstance(nf, NaturalField)
     np.testing.assert_allclose(nf.directors, np.tile([0.0, 0.0, 1.0], (40, 1)), atol=1e-14)
-    sec = MODEL.section(*_inks(), R, 0.5)
+    sec = MODEL.section(*_inks(), R, 0.5, 175.0)  # moduli at the temperature
     eps_par, _, eps_p = MODEL.strains(3.0, _inks()[1])
     k_expected = janus_curvature(eps_p - eps_par, MODEL.modulus_ratio, R) * nf.actuation
     np.testing.assert_allclose(nf.curvature1, k_expected, rtol=5e-3)
@@ -165,3 +166,23 @@ def _inks():
     from rotomorph.materials import get_material
 
     return get_material("lce"), get_material("acrylate")
+
+
+def test_default_model_is_the_stored_joint_calibration() -> None:
+    # one default: simulate, paper, the lattice and the examples all use FilamentModel(),
+    # whose parameters are the joint calibration's chosen fit (stored with their source)
+    from rotomorph.materials.calibrate import paper_calibration
+    from rotomorph.materials.natural import CALIBRATED, MODEL_NAMES, named_model
+
+    chosen = paper_calibration().chosen.values
+    assert set(chosen) == set(CALIBRATED)
+    for name, value in chosen.items():
+        assert CALIBRATED[name] == pytest.approx(value, rel=1e-6), name
+    default = FilamentModel()
+    assert default.modulus_ratio == CALIBRATED["modulus_ratio"]
+    assert default.passive_strain == CALIBRATED["passive_strain"]
+    assert named_model("calibrated") == default
+    assert named_model("room-temperature").moduli(*_inks()) == (29.67, 0.57)
+    assert set(MODEL_NAMES) == {"calibrated", "warner-terentjev", "room-temperature"}
+    with pytest.raises(InvalidParameterError, match="model"):
+        named_model("magic")

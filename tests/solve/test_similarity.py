@@ -30,7 +30,14 @@ class IsotropicStrain:
         return e, e
 
 
-ISOTROPIC = FilamentModel(strain_model=IsotropicStrain(), passive_strain=STRAIN, resolution=48)
+# every eigenstrain scaled by x(T) alike (the temperature laws would expand the passive ink
+# linearly in T while the LCE follows x(T): no longer isotropic at intermediate T)
+ISOTROPIC = FilamentModel(
+    strain_model=IsotropicStrain(),
+    passive_strain=STRAIN,
+    resolution=48,
+    temperature_dependent=False,
+)
 
 
 def _similarity_error(x: np.ndarray, ref: np.ndarray, scale: float) -> float:

@@ -31,9 +31,12 @@ calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for un
 
 from __future__ import annotations
 
+import csv
+import io
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from importlib import resources
 from typing import Any, Literal, cast
 
 import numpy as np
@@ -47,9 +50,15 @@ from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.morphology import HelixShape, free_helix
 from rotomorph.materials.process import (
     ActuationStrainModel,
+    EmpiricalThreshold,
     WarnerTerentjev,
     actuation_fraction,
     dimensionless_rotation,
+)
+from rotomorph.materials.temperature import (
+    active_modulus,
+    passive_modulus,
+    passive_strain_fraction,
 )
 
 logger = logging.getLogger(__name__)
@@ -58,15 +67,37 @@ logger = logging.getLogger(__name__)
 #: (α = ψ − α_n, notes 1.1; rotomorph.design.program).
 DIRECTOR_HELIX_SENSE = -1.0
 
-#: Effective E_a/E_p at actuation (Hencky WT strains, Q = S), calibrated on K_J(v = 3 mm/s) =
-#: 0.59 ± 0.04 mm⁻¹ with ``calibrate(load_table("janus_curvature"), ["modulus_ratio"], use=[3])``:
-#: 4.12 ± 1.2 (notes 1.7 quote 4.1). Re-run the calibration when changing the strain model.
-CALIBRATED_MODULUS_RATIO = 4.12
+
+def _calibrated_values() -> dict[str, float]:
+    """The default model's parameters (``data/model/calibrated_model.csv``, with their source)."""
+    text = resources.files("rotomorph.materials").joinpath("data/model/calibrated_model.csv")
+    rows = csv.DictReader(io.StringIO(text.read_text("utf-8")))
+    return {row["parameter"]: float(row["value"]) for row in rows}
+
+
+#: Parameters of the default :class:`FilamentModel`: the chosen branch of the joint calibration
+#: on the paper's filament measurements (:func:`rotomorph.materials.calibrate.paper_calibration`),
+#: stored so that ``simulate``, ``paper``, the examples and the lattice use one model. A test
+#: keeps the stored values equal to a fresh calibration.
+CALIBRATED = _calibrated_values()
+CALIBRATED_MODULUS_RATIO = CALIBRATED["modulus_ratio"]
+
+
+def _calibrated_strain_model() -> ActuationStrainModel:
+    return EmpiricalThreshold(
+        gain=CALIBRATED["strain_model.gain"],
+        threshold=CALIBRATED["strain_model.threshold"],
+        measure="hencky",
+    )
 
 
 @dataclass(frozen=True)
 class FilamentModel:
     """Modelling choices of the print-to-shape chain (all can be calibrated).
+
+    ``FilamentModel()`` is the calibrated default (:data:`CALIBRATED`): the threshold strain
+    law, the effective modulus ratio and the passive strain fitted jointly to the paper's
+    filament measurements. :func:`named_model` gives the others by name.
 
     Parameters
     ----------
@@ -86,15 +117,20 @@ class FilamentModel:
         ``"heating"`` or ``"cooling"`` branch of the actuation curve.
     resolution
         Boundary vertices of the section mesh.
+    temperature_dependent
+        Moduli and passive strain follow the temperature laws of
+        :mod:`rotomorph.materials.temperature` over a heating ramp (default); ``False``: the
+        full-actuation moduli at every temperature and every eigenstrain scaled by x(T).
     """
 
-    strain_model: ActuationStrainModel = field(default_factory=WarnerTerentjev)
+    strain_model: ActuationStrainModel = field(default_factory=_calibrated_strain_model)
     modulus_ratio: float | None = CALIBRATED_MODULUS_RATIO
-    passive_strain: float | None = None
+    passive_strain: float | None = CALIBRATED["passive_strain"]
     transition_width: float = 10.0
     hysteresis: float = 0.0
     direction: Literal["heating", "cooling"] = "heating"
     resolution: int = DEFAULT_RESOLUTION
+    temperature_dependent: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.strain_model, ActuationStrainModel):
@@ -110,18 +146,60 @@ class FilamentModel:
         if self.passive_strain is not None and not np.isfinite(self.passive_strain):
             raise InvalidParameterError("FilamentModel.passive_strain", "must be finite or None")
 
-    def moduli(self, active: Material, passive: Material) -> tuple[float, float]:
-        """(E_a, E_p) in MPa used for the section at actuation (see module docstring)."""
+    def fraction(self, active: Material, temperature: float) -> float:
+        """Actuation fraction x(T) ∈ [0, 1] of ``active`` at ``temperature`` (°C)."""
+        return float(
+            actuation_fraction(
+                temperature,
+                active.transition_temperature,  # type: ignore[arg-type]
+                self.transition_width,
+                direction=self.direction,
+                hysteresis=self.hysteresis,
+            )
+        )
+
+    def moduli(
+        self, active: Material, passive: Material, temperature: float | None = None
+    ) -> tuple[float, float]:
+        """(E_a, E_p) in MPa: at full actuation, or at ``temperature`` (°C).
+
+        At full actuation E_p is the passive ink's (25 °C) modulus and E_a = ratio × E_p (the
+        ratio is what matters for free shapes). With a temperature and
+        ``temperature_dependent``, the laws of :mod:`rotomorph.materials.temperature`: E_p
+        entropic, E_a from its measured 25 °C value to ratio × E_p(T) as x(T) goes 0 → 1.
+        """
         e_p = passive.youngs_modulus
         if self.modulus_ratio is None:
             return active.youngs_modulus, e_p
-        return self.modulus_ratio * e_p, e_p
+        if temperature is None or not self.temperature_dependent:
+            return self.modulus_ratio * e_p, e_p
+        e_p = passive_modulus(e_p, temperature)
+        x = self.fraction(active, temperature)
+        return active_modulus(active.youngs_modulus, self.modulus_ratio * e_p, x), e_p
+
+    def strains_at(
+        self, speed: float | FloatArray, active: Material, passive: Material, temperature: float
+    ) -> tuple[FloatArray, FloatArray, float]:
+        """Free strains (ε∥, ε⊥, ε_p) reached at ``temperature`` (°C) for print speed v (mm/s).
+
+        LCE strains x(T) × full; passive strain linear in T from 25 °C (thermal expansion;
+        the model's value at 175 °C) when ``temperature_dependent``, else x(T) × full.
+        """
+        e_par, e_perp, eps_p = self.strains(speed, passive)
+        x = self.fraction(active, temperature)
+        share = passive_strain_fraction(temperature) if self.temperature_dependent else x
+        return x * np.asarray(e_par), x * np.asarray(e_perp), share * eps_p
 
     def section(
-        self, active: Material, passive: Material, radius: float, active_fraction: float
+        self,
+        active: Material,
+        passive: Material,
+        radius: float,
+        active_fraction: float,
+        temperature: float | None = None,
     ) -> FilamentSection:
-        """The (cached) meshed section for these materials and geometry."""
-        e_a, e_p = self.moduli(active, passive)
+        """The (cached) meshed section for these materials and geometry (at ``temperature``)."""
+        e_a, e_p = self.moduli(active, passive, temperature)
         return filament_section(
             radius,
             e_a,
@@ -143,6 +221,39 @@ class FilamentModel:
             else float(self.passive_strain)
         )
         return e_par, e_perp, eps_p
+
+
+#: Names of :func:`named_model` (``rotomorph simulate --model``).
+MODEL_NAMES = ("calibrated", "warner-terentjev", "room-temperature")
+
+
+def named_model(name: str) -> FilamentModel:
+    """A filament model by name.
+
+    ``calibrated``
+        The default (:data:`CALIBRATED`): joint fit to the paper's filament measurements.
+    ``warner-terentjev``
+        Ideal-nematic-rubber strains with Q = S(v) (Warner & Terentjev, *Liquid Crystal
+        Elastomers*, OUP 2007) and the calibrated modulus ratio: a physical prior that does
+        not capture the speed dependence of the Janus curvature.
+    ``room-temperature``
+        Warner-Terentjev strains with the inks' measured 25 °C moduli (E_a/E_p = 52): known to
+        under-predict the Janus curvature 2-4×; shows what the measured moduli alone give.
+
+    Raises
+    ------
+    InvalidParameterError
+        Unknown name (the message lists the known ones).
+    """
+    if name == "calibrated":
+        return FilamentModel()
+    if name == "warner-terentjev":
+        return FilamentModel(strain_model=WarnerTerentjev(), passive_strain=None)
+    if name == "room-temperature":
+        return FilamentModel(
+            strain_model=WarnerTerentjev(), modulus_ratio=None, passive_strain=None
+        )
+    raise InvalidParameterError("model", f"must be one of {MODEL_NAMES}; got {name!r}")
 
 
 @compact_display()
@@ -306,10 +417,10 @@ def _vertex_increments(
     radius: float,
     model: FilamentModel,
     section: FilamentSection,
-    passive: Material,
+    state: tuple[Material, Material, float],
 ) -> tuple[FloatArray, FloatArray]:
-    """Full-actuation curvature vector ``(N-2, 3)`` and eigen-twist ``(N-2,)`` at the interior
-    vertices, sampled at the vertex (midpoint rule on its Voronoi cell).
+    """Curvature vector ``(N-2, 3)`` and eigen-twist ``(N-2,)`` at the interior vertices at the
+    temperature of ``state``, sampled at the vertex (midpoint rule on its Voronoi cell).
 
     The active side is the program's vertex interface normal (``vertex_interface_normals``;
     the mean of the two edge normals for programs without it). Sampling at vertices makes a
@@ -324,7 +435,8 @@ def _vertex_increments(
     else:
         n_v = np.asarray(vn, dtype=float)[1:-1]
     omega_v = DIRECTOR_HELIX_SENSE * dimensionless_rotation(rot[1:-1], speed[1:-1], radius)
-    e_par, e_perp, eps_p = model.strains(speed[1:-1], passive)
+    active, passive, temperature = state
+    e_par, e_perp, eps_p = model.strains_at(speed[1:-1], active, passive, temperature)
     _, kappa, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
     tb = geometry.unit(t[:-1] + t[1:])
     vec = kappa[:, :1] * n_v + kappa[:, 1:2] * np.cross(tb, n_v)
@@ -385,11 +497,11 @@ class ActuationIncrements:
     ----------
     curvature
         ``(N-2, 3)`` natural-curvature vectors added at the interior vertices (1/mm per printed
-        length, toward the side the filament bends to), x(T) included.
+        length, toward the side the filament bends to) at the temperature asked for.
     twist
         ``(N-2,)`` eigen-twist added at the interior vertices (1/mm per printed length).
     axial_strain
-        ``(N-1,)`` natural centre-line strain x·ε_c of each edge (model's measure).
+        ``(N-1,)`` natural centre-line strain ε_c(T) of each edge (model's measure).
     stretch
         ``(N-1,)`` rest length / printed length of each edge.
     normals
@@ -434,20 +546,13 @@ def actuation_increments(
     rot = np.asarray(getattr(program, "director_rotation", rot), dtype=float).reshape(-1)
     active = _material(program.active_material, materials, "active")
     passive = _material(program.passive_material, materials, "passive")
-    x = float(
-        actuation_fraction(
-            temperature,
-            active.transition_temperature,  # type: ignore[arg-type]
-            model.transition_width,
-            direction=model.direction,
-            hysteresis=model.hysteresis,
-        )
-    )
+    x = model.fraction(active, temperature)
     edge_speed = 0.5 * (speed[:-1] + speed[1:])
     edge_rot = 0.5 * (rot[:-1] + rot[1:])
     omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
-    section = model.section(active, passive, radius, frac)
-    e_par, e_perp, eps_p = model.strains(edge_speed, passive)
+    # section and free strains at this temperature (moduli and strains: temperature laws)
+    section = model.section(active, passive, radius, frac, temperature)
+    e_par, e_perp, eps_p = model.strains_at(edge_speed, active, passive, temperature)
     eps_c, _, _ = section.natural_strains(omega_star, e_par, e_perp, eps_p)
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
@@ -455,13 +560,15 @@ def actuation_increments(
     vn = getattr(program, "vertex_interface_normals", None)
     if getattr(program, "step_flips", False) and vn is not None:
         normals = _step_flip_normals(normals, np.asarray(vn, dtype=float), t)
-    vec, dtw = _vertex_increments(program, t, normals, speed, rot, radius, model, section, passive)
+    vec, dtw = _vertex_increments(
+        program, t, normals, speed, rot, radius, model, section, (active, passive, temperature)
+    )
     measure = model.strain_model.measure
-    axial = x * np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t))
+    axial = np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t))
     stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
     return ActuationIncrements(
-        curvature=x * vec,
-        twist=x * dtw,
+        curvature=vec,
+        twist=dtw,
         axial_strain=axial,
         stretch=stretch,
         normals=normals,

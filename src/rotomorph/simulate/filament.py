@@ -317,8 +317,9 @@ def simulate_filament(
     iterations_at: dict[float, int] = {}
 
     def solve(w: float, initial: State) -> StaticResult:
-        # w runs over the step index; a halved step blends its two end fields (the natural
-        # field is linear in the actuation, stiffness does not depend on it)
+        # w runs over the step index; a halved step blends its two end fields (linear in
+        # the eigenstrains; the moduli's slow temperature dependence is taken from the end
+        # field): only the halved sub-steps use a blend, every reported step is exact
         k = min(int(np.floor(w)), s - 2)
         field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
         res = solve_static(
