@@ -17,9 +17,6 @@ from rotomorph.inverse.lattice import (
     surface_misfit,
 )
 from rotomorph.inverse.run import lattice_design_file
-from rotomorph.lattice.actuation import ProgramActuation
-from rotomorph.materials.natural import FilamentModel
-from rotomorph.materials.process import WarnerTerentjev
 
 
 @pytest.fixture(scope="module")
@@ -27,11 +24,7 @@ def small():
     lat = sinusoidal_lattice(
         n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
     )
-    # a fixed materials model (Warner-Terentjev strains, E_a/E_p = 4.12) keeps this gradient
-    # check independent of the calibrated default, whose equilibria at this size leave central
-    # differences noisier than the 1e-5 asked below
-    legacy = FilamentModel(strain_model=WarnerTerentjev(), modulus_ratio=4.12, passive_strain=None)
-    return lat, lattice_blend(lat, ProgramActuation(filament_model=legacy))
+    return lat, lattice_blend(lat)
 
 
 def _gradient(blend, eq, c, target, size):

@@ -15,7 +15,7 @@ from rotomorph.materials.calibrate import filament_shapes
 from rotomorph.materials.closed_form import janus_curvature
 
 R = 0.3
-# full-actuation moduli and x(T)-scaled eigenstrains: the exact relations checked below
+# full-actuation moduli and x(T)-scaled eigenstrains (the default): the exact relations below
 MODEL = FilamentModel(resolution=64, temperature_dependent=False)
 
 

@@ -29,7 +29,8 @@ def test_every_law_states_its_status_and_source():
 
 
 def test_moduli_run_from_the_measured_cold_ratio_to_the_calibrated_hot_one():
-    model = FilamentModel()
+    model = FilamentModel(temperature_dependent=True)
+    assert FilamentModel().moduli(LCE, ACR, 25.0) == FilamentModel().moduli(LCE, ACR)
     cold = model.moduli(LCE, ACR, 25.0)
     hot = model.moduli(LCE, ACR, 175.0)
     assert cold[1] == pytest.approx(0.57)
@@ -52,7 +53,7 @@ def test_a_temperature_ramp_bends_a_janus_filament_progressively():
     from tests.materials.test_natural import Program
 
     prog = Program(np.column_stack([s, 0 * s, 0 * s]), np.full(21, 3.0), np.zeros(21), np.zeros(20))
-    model = FilamentModel(resolution=48)
+    model = FilamentModel(resolution=48, temperature_dependent=True)
     k = [natural_field(prog, temperature=t, model=model).curvature1[0] for t in (25, 80, 100, 175)]
     assert abs(k[0]) < 0.02 and np.all(np.diff(k) > 0) and k[-1] > 0.4
     # passive expansion starts at once (linear in T), the LCE only through its transition

@@ -118,9 +118,12 @@ class FilamentModel:
     resolution
         Boundary vertices of the section mesh.
     temperature_dependent
-        Moduli and passive strain follow the temperature laws of
-        :mod:`rotomorph.materials.temperature` over a heating ramp (default); ``False``: the
-        full-actuation moduli at every temperature and every eigenstrain scaled by x(T).
+        ``True``: moduli and passive strain follow the temperature laws of
+        :mod:`rotomorph.materials.temperature` over a heating ramp. ``False`` (default, what
+        the calibration and the paper report use): the full-actuation moduli at every
+        temperature and every eigenstrain scaled by x(T). Both give the same state at the
+        actuation temperature to 1e-3; they differ on the way (e.g. where a contracting
+        lattice first touches itself).
     """
 
     strain_model: ActuationStrainModel = field(default_factory=_calibrated_strain_model)
@@ -130,7 +133,7 @@ class FilamentModel:
     hysteresis: float = 0.0
     direction: Literal["heating", "cooling"] = "heating"
     resolution: int = DEFAULT_RESOLUTION
-    temperature_dependent: bool = True
+    temperature_dependent: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.strain_model, ActuationStrainModel):
