@@ -52,7 +52,6 @@ from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
 from rotomorph.materials.material import get_material
 from rotomorph.materials.natural import FilamentModel, actuation_increments
-from rotomorph.materials.process import actuation_fraction
 from rotomorph.rod.model import Model
 
 __all__ = [
@@ -243,17 +242,7 @@ class ThermalActuation:
 
     def fraction(self, lm: LatticeModel, temperature: float) -> float:
         """Actuation fraction x(T) ∈ [0, 1] (dimensionless)."""
-        fm = self._fm()
-        active = get_material(lm.lattice.active_material)
-        return float(
-            actuation_fraction(
-                temperature,
-                active.transition_temperature,  # type: ignore[arg-type]
-                fm.transition_width,
-                direction=fm.direction,
-                hysteresis=fm.hysteresis,
-            )
-        )
+        return self._fm().fraction(get_material(lm.lattice.active_material), temperature)
 
     def natural(self, lm: LatticeModel, parameter: float) -> Model:
         """Printed curvature plus x(T) K_J toward the active side, rest lengths × exp(x ε_c)."""
