@@ -1,4 +1,4 @@
-"""Benchmark: a free straight rod relaxing into the exact helix (issue 2).
+"""Benchmark: a free straight rod relaxing into the exact helix.
 
 Prints one JSON object per line: the helix case at N = 101, 1 001 and 10 001 nodes (wall time,
 Newton iterations, final residual, helix errors, time per iteration) and one

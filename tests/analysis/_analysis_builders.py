@@ -6,7 +6,7 @@ import numpy as np
 
 
 def sinusoidal_lattice(n: int = 5, spacing: float = 10.0, amplitude: float = 2.2, ghosts: int = 10):
-    """Square lattice of physics notes 2.7: positions (N, 3) and edge chains (ends included)."""
+    """The paper's square lattice: positions (N, 3) and edge chains (ends included)."""
     branch = np.array([[spacing * i, spacing * j, 0.0] for i in range(n) for j in range(n)])
     nodes = [branch]
     chains = []

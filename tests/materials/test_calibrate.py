@@ -24,7 +24,7 @@ def wt():
 
 
 def test_modulus_ratio_from_v3(wt) -> None:
-    # notes 1.7: m_eff = 4.1 with Hencky WT strains, S = 0.23
+    # reference values: m_eff = 4.1 with Hencky WT strains, S = 0.23
     assert wt.success
     assert wt.values["modulus_ratio"] == pytest.approx(4.1, abs=0.1)
     assert wt.residuals[3].used and wt.residuals[3].predicted == pytest.approx(0.59, abs=1e-6)
@@ -46,8 +46,8 @@ def test_room_temperature_ratio_underpredicts() -> None:
             strain_model=WarnerTerentjev(), modulus_ratio=None, passive_strain=None, resolution=64
         ),
     )
-    assert 0.59 / k[0] > 2.0  # notes 1.7 finding 1 (0.14 mm^-1 with m = 52)
-    # notes 1.7 table: 0.140 for engineering dEps = 0.222; Hencky dEps = ln(1.03/0.808) = 0.243
+    assert 0.59 / k[0] > 2.0  # the room-temperature ratio under-predicts (0.14 mm^-1 with m = 52)
+    # reference: 0.140 for engineering dEps = 0.222; Hencky dEps = ln(1.03/0.808) = 0.243
     assert k[0] == pytest.approx(0.1887 * 0.2427 / 0.3, rel=3e-3)
 
 
@@ -74,7 +74,7 @@ def test_empirical_two_speed_calibration_predicts_the_others(wt) -> None:
 
 def test_predict_rotated_filaments(wt) -> None:
     comp = predict("composite_length", [0.06, 2.0], wt.model)
-    # notes 1.7(4): 0.166 and 0.99 (Hencky); measured 0.22 +- 0.01, 0.98 +- 0.02
+    # reference values: 0.166 and 0.99 (Hencky); measured 0.22 +- 0.01, 0.98 +- 0.02
     np.testing.assert_allclose(comp, [0.166, 0.99], atol=0.01)
     pure = predict("pure_lce_length", [0.06, 1.0], wt.model)
     np.testing.assert_allclose(pure, [0.808, 0.891], atol=0.005)

@@ -1,4 +1,4 @@
-"""Closed-form free-filament helix (notes 1.6)."""
+"""Closed-form free-filament helix."""
 
 from __future__ import annotations
 

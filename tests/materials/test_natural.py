@@ -1,4 +1,4 @@
-"""Assembly of the natural field of one filament (Frame A, notes 1.5) and its closed-form shape."""
+"""Assembly of the natural field of one filament (Frame A) and its closed-form shape."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def straight(
     pts = np.column_stack([s, np.zeros(n), np.zeros(n)])
     rot = omega_star * speed / R
     mid = 0.5 * (s[:-1] + s[1:])
-    # design-layer convention (notes 1.1): alpha = psi - alpha_n, so d(alpha)/ds = -omega/v
+    # design-layer convention: alpha = psi - alpha_n, so d(alpha)/ds = -omega/v
     return Program(pts, np.full(n, speed), np.full(n, rot), -(rot / speed) * mid)
 
 
@@ -119,7 +119,7 @@ def test_cold_filament_keeps_printed_curvature_and_sign_of_actuation() -> None:
     )
     np.testing.assert_allclose(base, k_exact, rtol=1e-9)
     assert k_exact == pytest.approx(-1 / rho, rel=1e-3)
-    # heating an outer-active arc straightens it (|curvature| decreases, notes Q3)
+    # heating an outer-active arc straightens it (|curvature| decreases)
     assert np.all(np.abs(hot.curvature1) < np.abs(cold.curvature1))
     np.testing.assert_allclose(hot.voronoi_length, 2 * rho * math.sin(0.75 / (n - 1)), rtol=1e-12)
     with pytest.raises(InvalidDesignError, match=r"varies|uniform"):
@@ -141,7 +141,7 @@ def test_moduli_and_room_temperature_ratio() -> None:
     assert ea / ep == pytest.approx(MODEL.modulus_ratio)
     k52 = natural_field(straight(), model=FilamentModel(modulus_ratio=None, resolution=64))
     k4 = natural_field(straight(), model=MODEL)
-    # the 25 C ratio gives a 2-4x smaller curvature (notes 1.7)
+    # the 25 C ratio gives a 2-4x smaller curvature
     assert 2.0 < k4.curvature1[0] / k52.curvature1[0] < 5.0
     assert filament_section(R, ea, ep, resolution=64) is MODEL.section(lce, acr, R, 0.5)
 

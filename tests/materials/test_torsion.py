@@ -1,4 +1,4 @@
-"""Saint-Venant torsion FEM and natural twist (notes 1.4; benchmarks X6, X9, X10)."""
+"""Saint-Venant torsion FEM and natural twist (reference values; benchmarks X6, X9, X10)."""
 
 from __future__ import annotations
 
@@ -71,7 +71,7 @@ def test_pure_lce_twist_fem_vs_closed_form(omega_star: float) -> None:
     np.testing.assert_allclose(kappa, 0.0, atol=1e-8)
 
 
-# notes 1.4 FEM table: m, C/[(Ga+Gp) pi R^4/4], C/(Gp R^4), twist factor f_tau
+# reference FEM table: m, C/[(Ga+Gp) pi R^4/4], C/(Gp R^4), twist factor f_tau
 TORSION_TABLE = [
     (1, 1.000, 1.571, 0.500),
     (2, 0.931, 2.194, 0.568),

@@ -1,4 +1,4 @@
-"""Filament over a heating ramp: rod solver vs the closed-form free helix (notes 1.6)."""
+"""Filament over a heating ramp: rod solver vs the closed-form free helix."""
 
 from __future__ import annotations
 

@@ -41,7 +41,7 @@ def test_helix_converges_with_second_order_in_n():
 
 
 def test_helix_shape_does_not_depend_on_anisotropy():
-    # free rod: k = k_bar for any stiffness matrix (physics notes D4)
+    # free rod: k = k_bar for any stiffness matrix
     er, ep, _ = _helix_errors(101, b2_factor=3.7)
     assert er < 5e-3 and ep < 5e-3
 
@@ -68,7 +68,7 @@ def test_natural_curvature_alone_gives_a_circular_arc(b2):
 
 
 def test_cantilever_tip_moment_gives_a_circular_arc():
-    # clamped at s = 0 along x, tip moment M about z: theta(s) = M s / B (physics notes D5)
+    # clamped at s = 0 along x, tip moment M about z: theta(s) = M s / B
     n, length, B = 51, 10.0, 2e-2
     s = np.linspace(0, length, n)
     model = Model.chain(

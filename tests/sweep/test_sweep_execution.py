@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import without_wall_time
 
+from conftest import without_wall_time
 from rotomorph.sweep import load_sweep, plan_sweep, run_sweep
 from rotomorph.sweep.store import RunStore
 

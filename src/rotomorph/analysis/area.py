@@ -7,7 +7,7 @@ on the loop's best-fit plane (PCA):
 
 A self-intersecting loop gets its signed-area sum (lobes of opposite orientation cancel).
 
-Square sinusoidal lattices (physics notes 2.7): branch nodes ``0 .. n²-1`` in row-major order,
+Square sinusoidal lattices: branch nodes ``0 .. n²-1`` in row-major order,
 node ``k = n i + j`` at ``(l i, l j, 0)``; every lattice edge is a chain of node indices from one
 branch node to a neighbouring one, ghost nodes in between (both end nodes included).
 """

@@ -4,7 +4,7 @@ Polylines use the rod solver's conventions (:mod:`rotomorph.geometry`): the poin
 at an interior vertex is :math:`|kb|/\ell_V` with :math:`kb` the discrete curvature binormal and
 :math:`\ell_V = (|e|+|f|)/2` the Voronoi length (1/mm).
 
-Surfaces (physics notes 2.7; paper Fig. 4C/F): the points are aligned to their best-fit plane
+Surfaces (paper Fig. 4C/F): the points are aligned to their best-fit plane
 (PCA), :math:`z = a x^2 + b xy + c y^2 + d x + e y + f` is fitted by least squares and the
 principal curvatures are the eigenvalues of the shape operator :math:`S = I^{-1} II` of that
 graph at the centre :math:`(x, y) = (0, 0)`, with
@@ -242,7 +242,7 @@ class SurfaceFit:
     mean_curvature
         :math:`(k_1 + k_2)/2` (1/mm).
     small_slope_gaussian
-        :math:`4ac - b^2` (1/mm²), the small-slope approximation of physics notes 2.7.
+        :math:`4ac - b^2` (1/mm²), the small-slope approximation.
     gaussian_sign
         ``+1`` (dome-like), ``-1`` (saddle-like) or ``0`` (flat or cylindrical, within
         ``flat_tolerance``).

@@ -7,7 +7,7 @@ arc length        :math:`\sum_j |x_{j+1} - x_j|` (mm)
 end-to-end        :math:`|x_{N-1} - x_0|` (mm); ratio :math:`L/L_0` against a reference
 edge ratio        end-to-end ratio of one lattice edge chain (paper Fig. 3, Q13 "strain")
 helix             radius ρ, pitch P (mm, axial rise per turn), handedness (+1 right)
-morphology        from curvature κ and twist τ (1/mm), :math:`Λ = κ/|τ|` (notes 1.6)
+morphology        from curvature κ and twist τ (1/mm), :math:`Λ = κ/|τ|`
 ================  ====================================================================
 
 For a helix of curvature κ and torsion τ: :math:`ρ = κ/(κ^2+τ^2)`,
@@ -128,7 +128,7 @@ def edge_end_to_end_ratios(
 def mean_edge_strain(
     positions: FloatArray, reference: FloatArray, edge_chains: Sequence[IntArray]
 ) -> float:
-    """Mean end-to-end strain of the lattice edges, ``mean(ratio) - 1`` (physics notes Q13).
+    """Mean end-to-end strain of the lattice edges, ``mean(ratio) - 1``.
 
     Returns 0.0 for no chains.
     """
@@ -290,7 +290,7 @@ def turn_count(points: FloatArray) -> float:
 
 
 class Morphology(str, Enum):
-    """Deformation mode of a free filament (paper Fig. 2; physics notes 1.6)."""
+    """Deformation mode of a free filament (paper Fig. 2)."""
 
     STRAIGHT = "straight"
     TWISTED_ROD = "twisted rod"

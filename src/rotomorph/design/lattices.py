@@ -1,4 +1,4 @@
-r"""The paper's square lattice of sinusoidal edges (Methods, "Numerical simulation"; notes 2.7).
+r"""The paper's square lattice of sinusoidal edges (Methods, "Numerical simulation").
 
 Layout and numbering
 --------------------
@@ -8,7 +8,7 @@ Layout and numbering
   branch index, so the tangent T is +x or +y:
   first the x-edges ``(i, j) -> (i+1, j)`` ordered by ``j`` then ``i``, then the y-edges
   ``(i, j) -> (i, j+1)`` ordered by ``i`` then ``j``.
-* Ghost nodes of lattice edge ``e`` (paper's formula, notes Q8: N = ẑ × T on EVERY edge):
+* Ghost nodes of lattice edge ``e`` (paper's formula: N = ẑ × T on EVERY edge):
 
   .. math:: v(s) = v_{start} + T\,s\,l/(n_g+1) + N\,A\sin(2\pi s/(n_g+1)),\quad s = 1..n_g,
 
@@ -57,7 +57,7 @@ def _central(n: int, edges: IntArray, centre: str) -> BoolArray:
     i, j = np.divmod(edges, n)
     interior = (i > 0) & (i < n - 1) & (j > 0) & (j < n - 1)
     if centre == "central_cells":
-        # both end nodes strictly inside: the 2x2 central cells for n = 5 (12 edges; notes Q12)
+        # both end nodes strictly inside: the 2x2 central cells for n = 5 (12 edges)
         return cast(BoolArray, interior.all(axis=1))  # (E, 2) -> (E,): an array
     if centre == "interior":
         # every edge not on the perimeter (24 of 40 for n = 5)
@@ -247,7 +247,7 @@ class Lattice:
         Notes
         -----
         Each line's nozzle keeps the active half outer (expanding edges) or inner (contracting
-        edges) of the local curvature, flipping by π at inflections (notes Q6, see
+        edges) of the local curvature, flipping by π at inflections (see
         :meth:`PrintProgram.sinusoid_with_active_side`); layer ``k`` lies at
         ``z = k * layer_height`` (mm). Lines are printed x-lines (by j) then y-lines (by i), each
         in +x / +y.
@@ -347,7 +347,7 @@ def sinusoidal_lattice(
     n
         Branch nodes per side (>= 2); the paper uses 5 (25 nodes, 40 edges).
     spacing
-        Node spacing l (mm), > 0. Not given in the paper (notes Q5); default 5 mm.
+        Node spacing l (mm), > 0. Not given in the paper; default 5 mm.
     amplitude
         Sine amplitude A (mm), >= 0 (0 gives straight edges); default 1.25 mm (A/l = 0.25, Q5).
     ghost_nodes
@@ -357,7 +357,7 @@ def sinusoidal_lattice(
         ``'saddle'`` (the inverse), a sequence of one mode per lattice edge, or a map from edge
         index or branch-node pair ``(a, b)`` to mode.
     centre
-        Which edges are "central" for dome/saddle (notes Q12): ``'central_cells'`` (default; both
+        Which edges are "central" for dome/saddle: ``'central_cells'`` (default; both
         end nodes off the perimeter, 12 edges for n = 5) or ``'interior'`` (every edge not on
         the perimeter, 24 edges).
     layers, layer_height
@@ -401,7 +401,7 @@ def sinusoidal_lattice(
     z = np.array([0.0, 0.0, 1.0])
     for e, (a, b) in enumerate(edges):
         t = (branch_xyz[b] - branch_xyz[a]) / spacing
-        nrm = np.cross(z, t)  # N = z x T on every edge (notes 2.7, Q8)
+        nrm = np.cross(z, t)  # N = z x T on every edge
         ghosts.append(
             branch_xyz[a]
             + np.outer(s * spacing / per, t)

@@ -9,7 +9,7 @@ edge's direction after a ``Polyline``.
 Conventions
 -----------
 * Heading :math:`\psi` (rad): angle of the edge direction projected on the xy-plane,
-  counter-clockwise from lab +x seen from above (physics notes 1.1), unwrapped along the path.
+  counter-clockwise from lab +x seen from above, unwrapped along the path.
 * Signed planar curvature :math:`\kappa` (1/mm): positive for a left (counter-clockwise) turn,
   i.e. the centre of curvature lies on :math:`\hat z \times t`; computed at interior vertices as
   turning angle / Voronoi length, zero at the two ends.

@@ -1,6 +1,6 @@
 r"""Print programs: what the printer does along ONE filament (path, speed, nozzle angle).
 
-Symbols (paper, "Rotational multimaterial 3D printing"; physics notes 1.1):
+Symbols (paper, "Rotational multimaterial 3D printing"):
 
 ===================  =========================================================================
 ``speed`` v          print (translation) speed at each vertex (mm/s); the move that *leaves*
@@ -12,11 +12,11 @@ Symbols (paper, "Rotational multimaterial 3D printing"; physics notes 1.1):
 ``interface_angle``  :math:`\alpha`, the angle of n in the filament cross-section, measured from
                      :math:`d_1` (= :func:`rotomorph.geometry.space_parallel_directors`, i.e.
                      :math:`+\hat z` for a path in the xy-plane) toward :math:`d_2 = t\times d_1`
-``ω*``               rotation number :math:`R\omega/v` (paper eq. for ω*, notes Q1: R = filament
+``ω*``               rotation number :math:`R\omega/v` (paper eq. for ω*: R = filament
                      radius)
 ===================  =========================================================================
 
-Interface angle convention (notes 1.1, [DERIVED + ASSUMPTION]): the extrudate leaves the nozzle
+Interface angle convention (derived, with an assumption): the extrudate leaves the nozzle
 flowing along :math:`-\hat z` and is laid down along the path tangent t by the rigid rotation
 (about :math:`-\hat z\times t`) that takes :math:`-\hat z` to t. The nozzle's in-plane normal
 :math:`(\cos\alpha_n, \sin\alpha_n, 0)` is carried along, which gives, for a planar path with
@@ -387,7 +387,7 @@ def active_side_angle(
 
     ``side`` may also be an ``(N,)`` array of +1 (outer) / -1 (inner) per vertex.
     ``flip_length`` (mm, >= 0) spreads each π flip over that arc length (a moving average of
-    the step), so the nozzle turns at about ``π v / flip_length`` rad/s (notes Q6).
+    the step), so the nozzle turns at about ``π v / flip_length`` rad/s.
     """
     p = path if isinstance(path, Path) else Path(path)
     if isinstance(side, str):

@@ -1,4 +1,4 @@
-"""Design files: TOML (``schema_version = 1``) validated by pydantic v2 (DESIGN.md section 7).
+"""Design files: TOML (``schema_version = 1``) validated by pydantic v2.
 
 A design holds filaments and/or one lattice::
 
@@ -25,7 +25,7 @@ Per segment, ``speed`` (mm/s) overrides the filament's (piecewise-constant v(s))
 driven by at most one of ``rotation`` (ω, rad/s), ``rotation_number`` (ω*) or
 ``interface_angle_deg`` (α held constant, nozzle tracks the heading); a filament-level
 ``active_side = "outer" | "inner"`` keeps the active half on one side of the curvature
-(notes Q6), with ``flip_length`` (mm) spreading each π flip. Angles in files are in degrees
+, with ``flip_length`` (mm) spreading each π flip. Angles in files are in degrees
 (``*_deg``), everything else in mm, s, rad/s, psi. Process settings for G-code
 (``active_pressure``, ``passive_pressure`` in psi, ``prime_dwell``, ``release_dwell`` in s) sit
 in ``[nozzle]`` and may be overridden per filament or for the lattice (``docs/gcode.md``).

@@ -1,4 +1,4 @@
-"""Lattices that heat into expanding or contracting sheets, domes and saddles (issue 4).
+"""Lattices that heat into expanding or contracting sheets, domes and saddles.
 
 :mod:`~rotomorph.lattice.model` builds the rod model of a printed
 :class:`~rotomorph.design.lattices.Lattice`, :mod:`~rotomorph.lattice.actuation` maps a ramp

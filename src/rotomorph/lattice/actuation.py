@@ -2,7 +2,7 @@ r"""How heating changes the natural state of lattice edges: pluggable, named act
 
 An actuation maps a ramp parameter (the paper's x, or a temperature) to a rod
 :class:`~rotomorph.rod.model.Model` with new natural values. Only rod vertices are actuated;
-junction pairs keep their printed values (notes Q14), and the natural twist always stays
+junction pairs keep their printed values, and the natural twist always stays
 printed. κ0 below is the printed pointwise curvature (both material components, so a stencil
 that straddles a flip is scaled as a vector).
 
@@ -12,12 +12,12 @@ name            natural curvature at ramp parameter x (expanding = active outer 
 ==============  =============================================================================
 ``literal``     (a) the paper's words: κ̄ = (1 + x) κ0 on straightening, (1 − x) κ0 on curling
                 edges. Inverts the paper (expanding lattices contract, dome patterns give
-                saddles; notes Q4 and §6) — kept as a documented known fact.
+                saddles) — kept as a documented known fact.
 ``swapped``     (b) labels swapped (the reading that keeps the paper's signs): (1 − x) κ0 expanding,
                 (1 + x) κ0 contracting.
 ``radius``      (c) c multiplies the radius of curvature: κ0/(1 + x) expanding, κ0/(1 − x)
                 contracting (4 κ0 at x = 0.75; curling edges loop through themselves).
-``additive``    (d) physical rule of notes 1.5: κ̄ = κ0 + x K_J toward the active side (K_J the
+``additive``    (d) physical rule of the theory page: κ̄ = κ0 + x K_J toward the active side (K_J the
                 Janus curvature from the materials layer at the lattice's print speed, or given).
 ``thermal``     temperature T (°C) → actuation fraction x(T) (materials layer); κ̄ = κ0 +
                 x(T) K_J toward the active side and rest lengths × exp(x ε_c) (centre-line
@@ -106,7 +106,7 @@ def _check_range(name: str, start: float, end: float) -> None:
 
 @dataclass(frozen=True)
 class CurvatureScaling:
-    """Readings (a)-(c) of notes Q4: printed curvature multiplied by a factor c(x).
+    """Readings (a)-(c) of the paper's recipe: printed curvature times a factor c(x).
 
     Parameters
     ----------
@@ -181,7 +181,7 @@ def _additive(lm: LatticeModel, curvature: float, stretch: float = 1.0) -> Model
 
 @dataclass(frozen=True)
 class AdditiveCurvature:
-    """Reading (d): κ̄ = κ0 + x K_J toward the active side (notes 1.5).
+    """Reading (d): κ̄ = κ0 + x K_J toward the active side.
 
     Parameters
     ----------

@@ -11,7 +11,7 @@ seed; the sign of the Gaussian curvature must not (tested on several seeds).
 Measurements per step (index 0 = the flat printed state): the normalised projected area of the
 boundary loop (paper Fig. 3G), the quadratic-surface fit of the branch nodes (Gaussian sign and
 characteristic curvature √|k1 k2|, Fig. 4), the mean edge strain and every edge's end-to-end
-ratio (Fig. 4C/F "strain", notes Q13), and the smallest distance between non-adjacent
+ratio (Fig. 4C/F "strain"), and the smallest distance between non-adjacent
 segments relative to the filament diameter, ignoring pairs already closer than a diameter as
 printed (fused at junctions). Contact is not modelled: values < 1 mean filaments overlap and
 ``min_clearance`` ≈ 0 flags filaments passing through each other.
@@ -321,7 +321,7 @@ def lattice_gravity(
 def _measure(
     lattice: Lattice, pos: FloatArray, ref: FloatArray, loop: IntArray, fused: IntArray
 ) -> tuple:
-    # the branch nodes (paper, notes 2.7); a 2 x 2 lattice has too few, so all its nodes
+    # the branch nodes (paper); a 2 x 2 lattice has too few, so all its nodes
     pts = pos[lattice.branch_indices] if lattice.n >= 3 else pos
     fit = fit_quadratic_surface(pts, flat_tolerance=1e-6)
     return (

@@ -1,4 +1,4 @@
-r"""The discrete-elastic-rod model of a printed sinusoidal lattice (physics notes 2.5-2.7).
+r"""The discrete-elastic-rod model of a printed sinusoidal lattice.
 
 Directors
 ---------
@@ -18,7 +18,7 @@ B1 on flip segments) and the actuation adds curvature toward the active side (be
 Where the active side acts
 --------------------------
 Actuation is a natural-curvature increment *toward the active side* at every rod vertex
-(junction pairs keep their printed values, notes Q14). The flip inside a segment is treated as
+(junction pairs keep their printed values). The flip inside a segment is treated as
 a step at the segment's midpoint, which is exactly the boundary between the Voronoi regions of
 its two end nodes: each such vertex takes the side of its other (non-flip) segment. A vertex
 whose two segments lie on opposite sides (flip at a node) gets side 0 (no increment).
@@ -34,7 +34,7 @@ on the stencil's averaged material frames exactly as the rod kernels do
 Stiffness
 ---------
 ``"paper"``: isotropic circular section of radius R, B1 = B2 = E πR⁴/4, C = G πR⁴/2 with
-G = E/3 (ν = ½; the paper's "diameter a" corrected, notes 2.3/Q11), EA = E πR².
+G = E/3 (ν = ½; the paper's "diameter a" corrected), EA = E πR².
 ``"janus"``: B_n (toward m1 = n), B_η, C, EA of the meshed Janus section of
 :mod:`rotomorph.materials` at the calibrated actuation modulus ratio. ``layers`` multiplies
 every stiffness by the number of printed layers (stacked layers act as one thicker filament of

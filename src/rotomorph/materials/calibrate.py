@@ -6,7 +6,7 @@ name; straight filaments, full actuation, R = 0.3 mm, inks ``"lce"`` / ``"acryla
 * ``janus_curvature``: K_J (1/mm) of a half-and-half filament printed at speed x (mm/s), ω* = 0;
 * ``pure_lce_length``: L/L0 of a pure LCE filament at ω* = x, v = 3 mm/s; the uniform section has
   no natural curvature, so L/L0 = axial stretch (twisted rod);
-* ``composite_length``: L/L0 of the free Janus helix (notes 1.6) at ω* = x, v = 3 mm/s, with
+* ``composite_length``: L/L0 of the free Janus helix at ω* = x, v = 3 mm/s, with
   K = |κ̄| and τ = ω*/R + Δτ.
 
 :func:`calibrate` fits named float parameters of a
@@ -80,7 +80,7 @@ def filament_shapes(
     speed: float = ROTATION_SERIES_SPEED,
     radius: float = PAPER_RADIUS,
 ) -> list[HelixShape]:
-    """Closed-form free shapes (notes 1.6) of straight filaments printed at rotation rates ω*.
+    """Closed-form free shapes of straight filaments printed at rotation rates ω*.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-r"""Closed-form Janus and pure-LCE section results (physics notes 1.4), checked by quadrature/FEM.
+r"""Closed-form Janus and pure-LCE section results, checked by quadrature/FEM.
 
 Janus disk of radius R (mm): active half-disk ξ > 0 (ξ along the interface normal n), passive
 half ξ < 0, moduli E_a, E_p (MPa), ratio m = E_a/E_p. Half-disk moments: ∫ξ dA = 2R³/3,
@@ -163,6 +163,6 @@ def pure_lce_axial_strain(
     eps_parallel: float | FloatArray,
     eps_perpendicular: float | FloatArray,
 ) -> FloatArray:
-    """Natural axial strain of a homogeneous LCE filament: ε⊥ + Δ ln(1+ω*²)/ω*² (notes 1.7(5))."""
+    """Natural axial strain of a homogeneous LCE filament: ε⊥ + Δ ln(1+ω*²)/ω*²."""
     delta = np.asarray(eps_parallel, dtype=float) - np.asarray(eps_perpendicular, dtype=float)
     return eps_perpendicular + delta * h0(np.asarray(omega_star, dtype=float) ** 2)

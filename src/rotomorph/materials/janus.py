@@ -4,14 +4,14 @@ Combines the mesh (:mod:`~rotomorph.materials.mesh`), the axial quadrature
 (:mod:`~rotomorph.materials.section`) and the torsion FEM (:mod:`~rotomorph.materials.torsion`)
 for a disk of radius R whose segment x1 > d is active (LCE) and the rest passive.
 
-Eigenstrain field (physics notes 1.3, small-strain, the director of the LCE in the active phase
+Eigenstrain field (small-strain, the director of the LCE in the active phase
 is p = cos φ t + sin φ e_θ with the kinematic profile tan φ(r) = ω* r/R, Δ = ε∥ − ε⊥):
 
 * active:  ε*_zz = ε⊥ + Δ cos²φ(r),   γ* = Δ sin 2φ(r) e_θ  (engineering eigen-shear),
 * passive: ε*_zz = ε_p (isotropic),   γ* = 0.
 
 r is measured from the disk centre (the nozzle axis). The in-plane components ε*_rr, ε*_θθ only
-distort the section and are ignored by rod theory (notes 1.9).
+distort the section and are ignored by rod theory.
 """
 
 from __future__ import annotations
@@ -157,7 +157,7 @@ def filament_section(
         Young's moduli of the phases (MPa) at the temperature of interest; only their ratio
         matters for unloaded shapes.
     poisson_active, poisson_passive
-        Poisson ratios (G = E / (2(1 + ν)); 0.5 for elastomers, notes 1.2).
+        Poisson ratios (G = E / (2(1 + ν)); 0.5 for elastomers).
     active_fraction
         Area fraction of the active segment in (0, 1] (0.5 Janus, 1 pure LCE).
     resolution

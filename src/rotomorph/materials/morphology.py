@@ -1,7 +1,7 @@
 r"""Closed-form shapes of free filaments with uniform natural curvature and twist.
 
 A free rod (no loads, contact or gravity) reaches zero energy k = k̄ for any stiffness. Uniform
-k̄ = (K, 0, τ) with m1 along the curvature direction gives a helix (physics notes 1.6; Kirchhoff's
+k̄ = (K, 0, τ) with m1 along the curvature direction gives a helix (Kirchhoff's
 kinetic analogy, e.g. Love, *A Treatise on the Mathematical Theory of Elasticity*, §270):
 
 * radius ρ = K/(K² + τ²), pitch P = 2πτ/(K² + τ²) (τ > 0: right-handed),
@@ -68,7 +68,7 @@ def free_helix(
     measure: Literal["hencky", "engineering"] = "hencky",
     tol: float = 1e-9,
 ) -> HelixShape:
-    """Shape of a free filament with uniform natural curvature K and twist τ (notes 1.6).
+    """Shape of a free filament with uniform natural curvature K and twist τ.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 r"""Assembly: print program + materials + temperature → natural curvature, twist, stiffness.
 
-Frame A of the physics notes (1.5): the material director of every edge is the interface normal
+Frame A (interface-attached): the material director of every edge is the interface normal
 m1 = n (pointing into the active phase), n = cos α d1 + sin α d2 with d1 the space-parallel
 reference director of :func:`rotomorph.geometry.space_parallel_directors`. The printed filament
 is stress-free in its printed shape, so its printed curvatures and twist are measured on the
@@ -16,16 +16,16 @@ with K_J, Δτ, ε_c from the section of each edge (print speed and rotation ave
 end vertices) and averaged over the two edges of each interior vertex.
 
 Handedness: the LCE director, the material lines and the interface form helices of the same
-sense (notes 1.1), so the director helix in the filament frame turns with the part of dα/ds that
-the nozzle rotation causes. With the design layer's convention α = ψ − α_n (notes 1.1, planar
+sense, so the director helix in the filament frame turns with the part of dα/ds that
+the nozzle rotation causes. With the design layer's convention α = ψ − α_n (the theory page, planar
 paths: dα/ds = κ_p − ω/v) that rate is −ω/v, i.e. the signed rotation rate of the director
 field is ω*_dir = :data:`DIRECTOR_HELIX_SENSE` · Rω/v with sense −1. On straight stretches the
 printed twist dα/ds then has the sign of ω*_dir and the eigen-twist Δτ the opposite sign
 (untwisting); a warning is logged when a program contradicts this.
 
-Moduli at the actuation temperature are not measured (notes 1.2, Q9). The passive modulus is
+Moduli at the actuation temperature are not measured. The passive modulus is
 taken at its 25 °C value and the active one as ``FilamentModel.modulus_ratio`` × E_p: the
-room-temperature ratio 52 under-predicts the Janus curvature 2-4× (notes 1.7), so the ratio is
+room-temperature ratio 52 under-predicts the Janus curvature 2-4×, so the ratio is
 calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for unloaded shapes.
 """
 
@@ -64,7 +64,7 @@ from rotomorph.materials.temperature import (
 logger = logging.getLogger(__name__)
 
 #: Sign relating the nozzle rotation ω to the director-helix rate in the filament frame
-#: (α = ψ − α_n, notes 1.1; rotomorph.design.program).
+#: (α = ψ − α_n; rotomorph.design.program).
 DIRECTOR_HELIX_SENSE = -1.0
 
 
@@ -311,7 +311,7 @@ class NaturalField:
     measure: Literal["hencky", "engineering"] = "hencky"
 
     def morphology(self, *, rtol: float = 1e-6) -> HelixShape:
-        """Closed-form free-filament helix (notes 1.6) for a uniform natural field.
+        """Closed-form free-filament helix for a uniform natural field.
 
         Raises
         ------

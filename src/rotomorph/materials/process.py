@@ -5,9 +5,9 @@ dimensionless rotation rate ω* = Rω/v, surface helix angle φ = atan ω*, nema
 (WAXS), backbone anisotropy r, actuation stretches λ∥, λ⊥ and strains ε∥, ε⊥ (dimensionless).
 
 * Kinematics (paper, after Raney et al., PNAS 115, 1198 (2018)): φ = atan ω*. R is the
-  *filament* radius (physics notes Q1): material lines at radius r are helices with
+  *filament* radius: material lines at radius r are helices with
   tan φ(r) = rω/v = ω* r/R, so atan ω* is the exact surface value and the angle falls to zero on
-  the axis (notes 1.1).
+  the axis.
 * Order parameter: S(v) interpolates the two WAXS points of the paper (0.150 at 0.25 mm/s,
   0.230 at 3 mm/s) linearly in ln v. This is an *interpolation*, not a flow model (the paper
   attributes the trend to the Weissenberg number; Telles et al., PNAS 2025).
@@ -15,13 +15,13 @@ dimensionless rotation rate ω* = Rω/v, surface helix angle φ = atan ω*, nema
 
   - :class:`WarnerTerentjev`: ideal nematic rubber (Warner & Terentjev, *Liquid Crystal
     Elastomers*, OUP 2007): r = (1 + 2Q)/(1 - Q), λ∥ = r^(-1/3), λ⊥ = r^(1/6) with Q ≈ S
-    (assumption, notes 1.2).
+    (assumption).
   - :class:`EmpiricalThreshold`: effective axial strain ε∥ = -gain (S(v) - S0), calibrated to
-    the Janus curvature data (notes 1.7(3)); ε⊥ from volume conservation.
+    the Janus curvature data; ε⊥ from volume conservation.
 
 * Temperature → actuation fraction x(T) ∈ [0, 1]: logistic sigmoid through T_NI with a width;
   optional hysteresis shifts the midpoint to T_NI ± h/2 on heating / cooling. All eigenstrains
-  scale linearly with x (notes 1.2, partial actuation).
+  scale linearly with x (the theory page, partial actuation).
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def _check_measure(measure: str) -> None:
 def dimensionless_rotation(
     rotation: float | FloatArray, speed: float | FloatArray, radius: float
 ) -> FloatArray:
-    """Dimensionless rotation rate ω* = R ω / v (paper; R = filament radius, notes Q1).
+    """Dimensionless rotation rate ω* = R ω / v (paper; R = filament radius).
 
     Parameters
     ----------
@@ -97,7 +97,7 @@ def helix_angle(omega_star: float | FloatArray) -> FloatArray:
 def helix_angle_profile(
     r: float | FloatArray, radius: float, omega_star: float | FloatArray
 ) -> FloatArray:
-    """Radial director profile φ(r) = atan(ω* r / R) (rad; kinematic, notes 1.1).
+    """Radial director profile φ(r) = atan(ω* r / R) (rad; kinematic).
 
     Parameters
     ----------
@@ -121,7 +121,7 @@ def order_parameter(
 
     Between the measured points S is linear in ln v; outside them the first / last segment is
     extrapolated and the result clipped to [0, 0.99]. With the paper's two points this is
-    S = 0.1946 + 0.0322 ln(v / 1 mm/s) (S(0.5) = 0.172, S(1.75) = 0.213; notes 1.2).
+    S = 0.1946 + 0.0322 ln(v / 1 mm/s) (S(0.5) = 0.172, S(1.75) = 0.213).
 
     Parameters
     ----------
@@ -211,7 +211,7 @@ class WarnerTerentjev:
     measure
         Strain measure of the returned strains.
     order_scale
-        Q / S (dimensionless, default 1: the assumption Q ≈ S of notes 1.2).
+        Q / S (dimensionless, default 1: the assumption Q ≈ S of the theory page).
     """
 
     measure: Measure = "hencky"
@@ -232,7 +232,7 @@ class WarnerTerentjev:
 
 @dataclass(frozen=True)
 class EmpiricalThreshold:
-    """Calibrated effective strain ε∥ = -gain · max(S(v) - threshold, 0) (notes 1.7(3)).
+    """Calibrated effective strain ε∥ = -gain · max(S(v) - threshold, 0).
 
     The Janus curvature rises ×4.5 between 0.25 and 3 mm/s while S rises ×1.53, which WT with
     Q = S cannot reproduce; the data suggest an effective strain linear in S above a threshold
@@ -280,7 +280,7 @@ def actuation_fraction(
 
     x(T) = 1 / (1 + exp(-(T - T_mid)/w)) with T_mid = T_NI + h/2 on heating and T_NI - h/2 on
     cooling (a smooth stand-in for the normalized-length-vs-T curve of the paper's Fig. 1D,
-    which is not available numerically; an assumption, notes 1.2). Eigenstrains scale by x.
+    which is not available numerically; an assumption). Eigenstrains scale by x.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 r"""General cross-section mechanics by quadrature: axial stretch and bending (plane sections).
 
 For a section with Young's modulus field E(x) and axial eigenstrain field ε*_zz(x), minimising
-½∫E(ε_zz − ε*_zz)² dA over ε_zz = ε_c − κ·(x − c) gives (physics notes 1.4; the bimetal
+½∫E(ε_zz − ε*_zz)² dA over ε_zz = ε_c − κ·(x − c) gives (the bimetal
 set-up of Timoshenko, J. Opt. Soc. Am. 11, 233 (1925), generalised to any section):
 
 =========  ==========================================================  ==========

@@ -6,7 +6,7 @@ For a section with shear modulus G(x) (MPa) and an in-plane engineering eigen-sh
     ½ ∫ G |τ p + ∇w − γ*|² dA,        p(x) = (−x2, x1)
 
 (Saint-Venant's torsion problem, e.g. Timoshenko & Goodier, *Theory of Elasticity*, ch. 10,
-with an eigenstrain added as in physics notes 1.4). Eliminating w (P1 elements, one vertex
+with an eigenstrain added as for thermal strains). Eliminating w (P1 elements, one vertex
 pinned; the result does not depend on the origin of p):
 
 * K z = b with K_ab = ∫G ∇φ_a·∇φ_b, b_a = ∫G p·∇φ_a,

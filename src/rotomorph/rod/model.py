@@ -96,7 +96,7 @@ class Model:
     Notes
     -----
     Junction (branch-node pair) stencils use the isotropic mean ``(B1+B2)/2`` of both edges,
-    since the anisotropy axes of two crossing filaments need not align (physics notes, Q14).
+    since the anisotropy axes of two crossing filaments need not align.
     """
 
     network: Network

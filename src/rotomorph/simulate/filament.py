@@ -1,6 +1,6 @@
 """Simulate one printed filament over a heating ramp with the rod solver.
 
-Pipeline per actuation step (DESIGN.md section 1)::
+Pipeline per actuation step::
 
     PrintProgram ──natural_field(T)──► NaturalField ──Model.chain──► Model ──solve_static──►
     equilibrium ──analysis──► L/L0, helix fit, morphology
@@ -92,7 +92,7 @@ class FilamentSimulation:
     morphology
         Label of the final shape (from its median curvature and material twist).
     closed_form
-        Closed-form free-helix prediction (notes 1.6) for a uniform natural field, else ``None``.
+        Closed-form free-helix prediction for a uniform natural field, else ``None``.
     wall_time
         Seconds spent.
     states
