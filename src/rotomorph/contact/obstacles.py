@@ -36,7 +36,7 @@ def _positive(field: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class Floor:
-    """A rigid half-space below the plane ``normal . x = height`` (the bath bottom, a substrate).
+    """A rigid half-space below the plane ``normal·x = height`` (the bath bottom, a substrate).
 
     Parameters
     ----------
