@@ -26,13 +26,13 @@ import numpy as np
 
 from rotomorph.analysis.curvature import discrete_curvature
 from rotomorph.design.lattices import sinusoidal_lattice
-from rotomorph.inverse.adjoint import adjoint
 from rotomorph.inverse.filament import design_filament
 from rotomorph.inverse.lattice import (
     _Equilibria,
     design_lattice,
     dome,
     lattice_blend,
+    misfit_and_gradient,
     saddle,
     surface_misfit,
 )
@@ -68,13 +68,7 @@ def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
     c = np.array([0.8 if m == "expanding" else -0.8 for m in lattice.edge_mode])
     size = lattice.spacing * (lattice.n - 1)
     res = eq(c)
-    _, gx, _ = surface_misfit(res.positions, target, size)
-    model = blend.rod(c)
-    lay = model.layout
-    dj = np.zeros(lay.count)
-    dj[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
-    s = adjoint(model, res.state, dj).sensitivity
-    g = -blend.gradient(c, np.stack([s.curvature1, s.curvature2, s.twist], axis=1), s.rest_length)
+    _, g = misfit_and_gradient(blend, c, res, target, size)
     worst = 0.0
 
     def central(e: int, h: float) -> float:

@@ -7,13 +7,13 @@ import pytest
 
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.errors import InvalidDesignError
-from rotomorph.inverse.adjoint import adjoint
 from rotomorph.inverse.lattice import (
     _Equilibria,
     design_lattice,
     dome,
     height_map,
     lattice_blend,
+    misfit_and_gradient,
     surface_misfit,
 )
 from rotomorph.inverse.run import lattice_design_file
@@ -29,13 +29,7 @@ def small():
 
 def _gradient(blend, eq, c, target, size):
     res = eq(c)
-    j, gx, _ = surface_misfit(res.positions, target, size)
-    model = blend.rod(c)
-    lay = model.layout
-    dj = np.zeros(lay.count)
-    dj[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
-    s = adjoint(model, res.state, dj).sensitivity
-    g = -blend.gradient(c, np.stack([s.curvature1, s.curvature2, s.twist], axis=1), s.rest_length)
+    j, g = misfit_and_gradient(blend, c, res, target, size)
     return j, g, res.state
 
 

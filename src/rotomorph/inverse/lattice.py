@@ -64,6 +64,7 @@ __all__ = [
     "design_lattice",
     "dome",
     "height_map",
+    "misfit_and_gradient",
     "saddle",
     "surface_misfit",
 ]
@@ -541,6 +542,37 @@ class LatticeDesign:
         return {int(e): ("expanding" if m > 0 else "contracting") for e, m in enumerate(self.modes)}
 
 
+def misfit_and_gradient(
+    blend: LatticeBlend,
+    c: FloatArray,
+    result: StaticResult,
+    target: SurfaceTarget,
+    size: float,
+    nodes: IntArray | None = None,
+) -> tuple[float, FloatArray]:
+    """Aligned misfit ``J`` of the equilibrium ``result`` of design ``c`` and ``dJ/dc`` ``(E,)``.
+
+    One adjoint solve at the equilibrium (:func:`rotomorph.inverse.adjoint.adjoint`), whatever
+    the number of edges; ``nodes`` (default all) are the nodes compared with the target.
+
+    Raises
+    ------
+    NotAMinimumError
+        The equilibrium is not a stable minimum.
+    """
+    picked = np.arange(len(result.positions)) if nodes is None else np.asarray(nodes)
+    j, gsel, _ = surface_misfit(result.positions[picked], target, size)
+    gx = np.zeros_like(result.positions)
+    gx[picked] = gsel
+    model = blend.rod(c)
+    lay = model.layout
+    dj_dx = np.zeros(lay.count)
+    dj_dx[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
+    s = adjoint(model, result.state, dj_dx).sensitivity
+    prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1)
+    return j, -blend.gradient(c, prod, s.rest_length)
+
+
 def _check_target(lattice: Lattice, target: SurfaceTarget) -> None:
     size = lattice.spacing * (lattice.n - 1)
     ext = getattr(target, "extent", None)
@@ -634,20 +666,10 @@ def design_lattice(
             res = eq(c)
         except ConvergenceError:
             return np.inf, np.zeros_like(c)
-        j, gsel, _ = surface_misfit(res.positions[picked], target, size)
-        gx = np.zeros_like(res.positions)
-        gx[picked] = gsel
-        model = blend.rod(c)
-        lay = model.layout
-        dj_dx = np.zeros(lay.count)
-        dj_dx[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
         try:
-            adj = adjoint(model, res.state, dj_dx)
+            j, grad = misfit_and_gradient(blend, c, res, target, size, picked)
         except NotAMinimumError:
             return np.inf, np.zeros_like(c)
-        s = adj.sensitivity
-        prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1)
-        grad = -blend.gradient(c, prod, s.rest_length)
         j += weight[0] * float(np.sum(1.0 - c * c))
         grad += weight[0] * (-2.0 * c)
         history.append(j)
