@@ -149,6 +149,15 @@ class RunResults:
         """Number of stored actuation steps S."""
         return int(self.positions.shape[0])
 
+    def step_labels(self) -> list[str]:
+        """One label per step for titles: temperature (°C), else actuation x, else the index."""
+        sc = self.scalars
+        if "temperature" in sc:
+            return [f"T = {t:.0f} °C" for t in sc["temperature"]]
+        if "actuation" in sc:
+            return [f"x = {x:.2f}" for x in sc["actuation"]]
+        return [f"step {k}" for k in range(self.n_steps)]
+
 
 def to_jsonable(value: Any) -> Any:
     """Convert numpy scalars/arrays, paths, enums and tuples into JSON types; NaN/inf → None."""

@@ -66,15 +66,6 @@ def _radius(results: RunResults) -> np.ndarray | float:
     return DEFAULT_RADIUS
 
 
-def _labels(results: RunResults) -> list[str]:
-    sc = results.scalars
-    if "temperature" in sc:
-        return [f"T = {t:.0f} °C" for t in sc["temperature"]]
-    if "actuation" in sc:
-        return [f"x = {x:.2f}" for x in sc["actuation"]]
-    return [f"step {k}" for k in range(results.n_steps)]
-
-
 def write_viewer(
     results: RunResults,
     path: str | os.PathLike[str],
@@ -122,7 +113,7 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     radius = _radius(results)
     frac = results.static.get("active_fraction", 0.5)
     verdicts = assess(results.scalars, results.metadata, s)
-    labels = _labels(results)
+    labels = results.step_labels()
     values = None if field == "janus" else _segment_field(results, field)
     if values is not None:
         # the figures' limits: robust, symmetric for signed data, round-off drawn as neutral

@@ -65,15 +65,6 @@ def _kind(results: RunResults) -> str:
     return str(results.metadata.get("kind", "filaments"))
 
 
-def _labels(results: RunResults) -> list[str]:
-    sc = results.scalars
-    if "temperature" in sc:
-        return [f"T = {t:.0f} °C" for t in sc["temperature"]]
-    if "actuation" in sc:
-        return [f"x = {x:.2f}" for x in sc["actuation"]]
-    return [f"step {i}" for i in range(results.n_steps)]
-
-
 def _verdicts(results: RunResults) -> list[StepVerdict]:
     return assess(results.scalars, results.metadata, results.n_steps)
 
@@ -84,7 +75,7 @@ def _state_title(results: RunResults, k: int, verdicts: list[StepVerdict]) -> tu
     where = "printed" if k == 0 else ("end of heating ramp" if k == last else f"step {k}/{last}")
     v = verdicts[k] if k < last else run_verdict(verdicts)
     colour = _RED if v.verdict == "no" else "k"
-    return f"{where}, {_labels(results)[k]} — {v.text()}", colour
+    return f"{where}, {results.step_labels()[k]} — {v.text()}", colour
 
 
 def _chains(results: RunResults) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -204,7 +195,7 @@ def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
                 if v.verdict == "yes"
                 else ("\nNOT PHYSICAL" if v.verdict == "no" else "\nunverified")
             )
-            panels.append(_lattice_panel(results, k, f"{head}, {_labels(results)[k]}{mark}"))
+            panels.append(_lattice_panel(results, k, f"{head}, {results.step_labels()[k]}{mark}"))
         return plot_tube_panels(panels, suptitle=title, suptitle_colour=colour, columns=3)
     panels = _filament_panels(results, last)
     return plot_tube_panels(
@@ -233,7 +224,7 @@ def _lattice_field_figure(results: RunResults, verdicts: list[StepVerdict]) -> A
     for k in steps:
         head = "printed" if k == 0 else ("end of ramp" if k == last else "before the failure")
         mark = {"no": "\nNOT PHYSICAL", "unknown": "\nunverified"}.get(verdicts[k].verdict, "")
-        p = _lattice_panel(results, k, f"{head}, {_labels(results)[k]}{mark}")
+        p = _lattice_panel(results, k, f"{head}, {results.step_labels()[k]}{mark}")
         panels.append(type(p)(**{**p.__dict__, "values": values[k]}))
     title, colour = _state_title(results, last, verdicts)
     return plot_tube_panels(
@@ -267,7 +258,7 @@ def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
             p = _filament_panels(results, k, rows=[i])[0]
             mark = {"no": " NOT PHYSICAL"}.get(_filament_step_verdict(results, i, k, verdicts), "")
             first = p.title.split("\n")[0]
-            label = f"{first}\n{_labels(results)[k]}{mark}"
+            label = f"{first}\n{results.step_labels()[k]}{mark}"
             panels.append(type(p)(**{**p.__dict__, "title": label}))
     v = run_verdict(verdicts)
     note = "" if v.verdict == "yes" else f" — {v.text()}"
