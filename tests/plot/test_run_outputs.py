@@ -6,6 +6,7 @@ written with :func:`write_results` and read back, so these tests are fast.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 import subprocess
@@ -167,25 +168,79 @@ def test_cli_plot_and_view(run_file, tmp_path, capsys):
     assert "nope" in capsys.readouterr().err
 
 
-def test_viewer_figure_has_a_frame_per_step_and_both_sides(run_file):
+def _vertices(trace):
+    return np.c_[np.asarray(trace.x), np.asarray(trace.y), np.asarray(trace.z)]
+
+
+def test_viewer_frames_carry_only_what_changes(run_file):
     pytest.importorskip("plotly")
     from rotomorph.plot.viewer import viewer_fields, viewer_figure
 
     res = read_results(run_file)
     assert viewer_fields(res)[0] == "janus" and "curvature" in viewer_fields(res)
     fig = viewer_figure(res, facets=6)
-    assert len(fig.frames) == res.n_steps
-    mesh = fig.frames[-1].data[0]
-    inten = np.asarray(mesh.intensity)
+    base = fig.data[0]
+    tri = np.c_[np.asarray(base.i), np.asarray(base.j), np.asarray(base.k)]
+    inten = np.asarray(base.intensity)
     assert set(np.unique(inten)) == {0.0, 1.0}  # active and passive halves both shown
-    tri = np.c_[np.asarray(mesh.i), np.asarray(mesh.j), np.asarray(mesh.k)]
-    verts = np.c_[np.asarray(mesh.x), np.asarray(mesh.y), np.asarray(mesh.z)]
-    assert tri.max() < len(verts) and len(inten) == len(tri)
-    area = np.linalg.norm(
-        np.cross(verts[tri[:, 1]] - verts[tri[:, 0]], verts[tri[:, 2]] - verts[tri[:, 0]]), axis=1
-    )
-    assert area.min() > 1e-6  # no degenerate triangles
+    assert len(inten) == len(tri) and tri.max() < len(_vertices(base))
+    assert len(fig.frames) == res.n_steps
+    for k, frame in enumerate(fig.frames):
+        assert list(frame.traces) == [0] and len(frame.data) == 1
+        moving = frame.data[0]
+        # the triangles and the Janus colours live once, in the base trace
+        assert set(moving.to_plotly_json()) == {"type", "x", "y", "z"}, k
+        verts = _vertices(moving)
+        assert verts.shape == _vertices(base).shape and np.asarray(moving.x).dtype == np.float32
+        area = np.linalg.norm(
+            np.cross(verts[tri[:, 1]] - verts[tri[:, 0]], verts[tri[:, 2]] - verts[tri[:, 0]]),
+            axis=1,
+        )
+        assert area.min() > 1e-6, k  # no degenerate triangles in any state
+        # every vertex lies on a tube around this step's centre line (float32 round-off)
+        nodes = res.positions[k]
+        d = np.linalg.norm(verts[:, None, :] - nodes[None, :, :], axis=2).min(axis=1)
+        assert d.max() < 0.3 * 1.6 and d.min() > 0.3 * 0.5
+        names = [a.text for a in frame.layout.scene.annotations]
+        assert names == ["coil", "straight"]
+    np.testing.assert_array_equal(_vertices(fig.frames[-1].data[0]), _vertices(base))
     assert "NOT PHYSICAL" in fig.frames[-1].layout.title.text
+    slider = fig.layout.sliders[0]
+    assert [st.label for st in slider.steps] == res.step_labels()
+    assert [st.args[0][0] for st in slider.steps] == [f.name for f in fig.frames]
+    # a field that stays the same over the ramp lives once; one that changes rides along
+    still = viewer_figure(res, field="curvature", facets=6)
+    assert all(set(f.data[0].to_plotly_json()) == {"type", "x", "y", "z"} for f in still.frames)
+    ramp = np.linspace(0.0, 1.0, res.n_steps)[:, None] * np.ones_like(res.fields["curvature"])
+    changing = dataclasses.replace(res, fields={**res.fields, "curvature": ramp})
+    field = viewer_figure(changing, field="curvature", facets=6)
+    for k, f in enumerate(field.frames):
+        assert set(f.data[0].to_plotly_json()) == {"type", "x", "y", "z", "intensity"}
+        assert np.allclose(np.asarray(f.data[0].intensity), ramp[k, 0])
+
+
+def test_viewer_file_is_small_and_self_contained(run_file, tmp_path):
+    pytest.importorskip("plotly")
+    from plotly.offline import get_plotlyjs
+
+    from rotomorph.plot.viewer import viewer_figure, write_viewer
+
+    res = read_results(run_file)
+    path = write_viewer(res, tmp_path / "v.html", facets=8)
+    base = viewer_figure(res, facets=8).data[0]
+    n_vert, n_tri = len(np.asarray(base.x)), len(np.asarray(base.i))
+    # plotly.js, then base64 (4/3) of float32 vertices for the base trace and every frame,
+    # int32 triangles and float32 colours once, the printed shape (float32, 3 points a
+    # segment) and 25 kB of page, layout, titles and slider
+    n_seg = n_tri // 16
+    data = 4 / 3 * (4 * 3 * n_vert * (res.n_steps + 1) + 4 * 3 * n_tri + 4 * n_tri)
+    bound = len(get_plotlyjs().encode()) + data + 4 / 3 * 4 * 9 * n_seg + 25_000
+    size = path.stat().st_size
+    assert size <= bound, (size, bound)
+    # with every frame repeating the triangles (the old layout) it would not fit
+    assert size + 4 / 3 * 12 * n_tri * (res.n_steps - 1) > bound
+    html = path.read_text(encoding="utf-8")
+    assert "<script src=" not in html and "plotly.js v" in html  # plotly.js inline: offline
 
 
 def test_movie_falls_back_to_a_gif_without_ffmpeg(tmp_path, monkeypatch):

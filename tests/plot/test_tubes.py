@@ -63,6 +63,24 @@ def test_tube_facets_lie_on_the_tube_and_split_by_the_normal():
     assert none is None
 
 
+def test_neighbouring_segments_share_their_end_rings():
+    pts, edges, inward = coil()
+    k = 12
+    quads, _, _, _ = tube_mesh(pts, edges, 0.4, inward, facets=k)
+    start = quads[:, 0].reshape(len(edges), k, 3)  # ring at each segment's first node
+    end = quads[:, 3].reshape(len(edges), k, 3)  # ... and at its second
+    # one ring where two segments meet: no gap and no seam between the tube's pieces
+    np.testing.assert_allclose(end[:-1], start[1:], atol=1e-12)
+    # where the active side flips, each segment keeps its own ring (the colours stay sharp)
+    flipped = inward.copy()
+    flipped[30:] *= -1
+    quads, _, _, _ = tube_mesh(pts, edges, 0.4, flipped, facets=k)
+    start = quads[:, 0].reshape(len(edges), k, 3)
+    end = quads[:, 3].reshape(len(edges), k, 3)
+    assert not np.allclose(end[29], start[30])
+    np.testing.assert_allclose(end[30:-1], start[31:], atol=1e-12)
+
+
 def test_tube_mesh_rejects_bad_input():
     pts, edges, inward = coil(10)
     with pytest.raises(InvalidParameterError, match="facets"):

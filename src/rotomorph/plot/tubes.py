@@ -3,10 +3,11 @@
 A segment of a printed Janus filament is a cylinder of radius R split by the interface: the
 half on the side of the interface normal n (toward the active ink) is active. :func:`tube_mesh`
 turns a network's segments into quadrilateral facets (``facets`` around each segment, mitred at
-ordinary nodes so neighbouring segments meet without gaps) and tells, per facet, whether it
-lies on the active side. With an active area fraction f ≠ ½ the interface is a chord at distance
-d from the axis, :math:`f = (θ - \\sin θ)/2π` with :math:`θ = 2\\arccos(d/R)`; a facet is
-active when its outward direction u satisfies :math:`u·n > d/R`.
+ordinary nodes, where neighbouring segments share their end rings: no gaps, no seams) and tells,
+per facet, whether it lies on the active side. With an active area fraction f ≠ ½ the interface
+is a chord at distance d from the axis, :math:`f = (θ - \\sin θ)/2π` with
+:math:`θ = 2\\arccos(d/R)`; a facet is active when its outward direction u satisfies
+:math:`u·n > d/R`.
 
 :func:`plot_tube_panels` draws one or more states side by side in 3-D on one common scale (the
 same millimetres per pixel in every panel), with Lambert–Phong shading, a faint ghost of the
@@ -82,15 +83,23 @@ def _any_perpendicular(t: FloatArray) -> FloatArray:
     return _unit(np.cross(t, helper))
 
 
-def _end_tangents(pos: FloatArray, edges: IntArray, t: FloatArray) -> FloatArray:
-    """Plane normal of each segment's two end rings ``(E, 2, 3)``: the bisector of the two
-    segments at an ordinary node (a mitre), the segment's own tangent elsewhere."""
+def _end_frames(
+    pos: FloatArray, edges: IntArray, t: FloatArray, ref: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Plane normal and reference direction of each segment's two end rings ``(E, 2, 3)``.
+
+    At an ordinary node (two segments, no hairpin) both segments' rings lie in the bisector
+    plane (a mitre) and, where their reference directions agree (``ref`` within 90°), share
+    the mean of the two, so the rings coincide and the tube has no seam; elsewhere each end
+    has its segment's own tangent and reference direction.
+    """
     n = len(pos)
     incident: list[list[int]] = [[] for _ in range(n)]
     for j, (a, b) in enumerate(edges):
         incident[a].append(j)
         incident[b].append(j)
     out = np.repeat(t[:, None, :], 2, axis=1)
+    refs = np.repeat(ref[:, None, :], 2, axis=1)
     for node, inc in enumerate(incident):
         if len(inc) != 2:
             continue
@@ -101,10 +110,13 @@ def _end_tangents(pos: FloatArray, edges: IntArray, t: FloatArray) -> FloatArray
         if float(te @ tf) < -0.5:  # a hairpin: a mitre would be degenerate
             continue
         mitre = _unit(te + tf)
+        shared = _unit(ref[e] + ref[f]) if float(ref[e] @ ref[f]) > 0.0 else None
         for j in inc:
             end = 0 if edges[j, 0] == node else 1
             out[j, end] = mitre if float(mitre @ t[j]) >= 0 else -mitre
-    return out
+            if shared is not None:
+                refs[j, end] = shared
+    return out, refs
 
 
 def tube_mesh(
@@ -159,9 +171,9 @@ def tube_mesh(
     ref = _any_perpendicular(t) if normals is None else np.asarray(normals, dtype=float)
     if ref.shape != (m, 3):
         raise InvalidParameterError("normals", f"must have shape ({m}, 3); got {ref.shape}")
-    ends = _end_tangents(pos, e, t)
+    ends, refs = _end_frames(pos, e, t, ref)
     centres = np.stack([a, b], axis=1)  # (E, 2, 3)
-    u = ref[:, None, :] - np.einsum("eij,ej->ei", ends, ref)[..., None] * ends
+    u = refs - np.einsum("eij,eij->ei", ends, refs)[..., None] * ends
     bad = np.linalg.norm(u, axis=-1) < 1e-9  # normal along the tangent: any perpendicular
     if bad.any():
         fallback = np.repeat(_any_perpendicular(t)[:, None, :], 2, axis=1)
