@@ -2,13 +2,15 @@
 
 Cases: ``filament-spiral`` (planar spiral), ``filament-perversion`` (tendril-like curve whose
 handedness reverses), ``lattice-dome`` and ``lattice-saddle`` (5 × 5 paper lattice, adjoint
-optimisation of the per-edge modes, then rounding to printable modes and a fresh forward
-verification). Fields: ``case``, ``n_design_variables``, ``iterations``, ``wall_s``,
-``rms_error_rel`` (filaments: RMS centre-line error / length; lattices: RMS height misfit /
-lattice size), ``target_metric`` and ``achieved_metric`` (filaments: mean |curvature| of the
-target and of the simulated design, 1/mm; lattices: Gaussian curvature K, 1/mm²),
-``gradient_fd_rel_err`` (lattices: adjoint gradient vs central differences on three edges;
-filaments: null, their design is direct), ``reachable`` / ``stable`` flags.
+optimisation of the per-edge modes and print speeds, then rounding to printable modes and
+speeds and a fresh forward verification). Fields: ``case``, ``n_design_variables``,
+``iterations``, ``wall_s``, ``rms_error_rel`` (filaments: RMS centre-line error / length;
+lattices: RMS height misfit / lattice size), ``target_metric`` and ``achieved_metric``
+(filaments: mean |curvature| of the target and of the simulated design, 1/mm; lattices:
+Gaussian curvature K, 1/mm²), ``gradient_fd_rel_err`` (lattices: adjoint gradient vs central
+differences on three mode and three speed variables; filaments: null, their design is
+direct), ``reachable`` / ``stable`` flags. Lattice cases also report ``cpu_s`` (process CPU
+time, which the machine's load does not inflate) and ``load_1min``.
 
 Targets: filament cases ≤ 5 s (the material response table is built once per session and
 reported separately as ``response-table``), 5 × 5 lattice cases ≤ 60 s on one core.
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 
 import numpy as np
@@ -38,6 +41,7 @@ from rotomorph.inverse.lattice import (
 )
 from rotomorph.inverse.response import response_table
 from rotomorph.inverse.targets import CurveSpec, curve_points
+from rotomorph.solve.newton import NewtonOptions
 
 
 def _emit(**row: object) -> None:
@@ -63,24 +67,29 @@ def filament_case(name: str, spec: CurveSpec, table) -> None:  # type: ignore[no
 
 
 def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
+    """Worst relative error of the adjoint gradient against Richardson-extrapolated central
+    differences, on three mode and three speed variables (perturbed solves to rtol 1e-13)."""
     blend = lattice_blend(lattice)
     eq = _Equilibria(blend)
     c = np.array([0.8 if m == "expanding" else -0.8 for m in lattice.edge_mode])
+    p = np.concatenate([c, np.linspace(1.0, 2.5, blend.n_edges)])
     size = lattice.spacing * (lattice.n - 1)
-    res = eq(c)
-    _, g = misfit_and_gradient(blend, c, res, target, size)
+    res = eq(p)
+    _, g = misfit_and_gradient(blend, p, res, target, size)
+    eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
     worst = 0.0
 
     def central(e: int, h: float) -> float:
         vals = []
         for sgn in (1, -1):
-            cc = c.copy()
-            cc[e] += sgn * h
-            eq.last = (c, res.state)
-            vals.append(surface_misfit(eq(cc).positions, target, size)[0])
+            pp = p.copy()
+            pp[e] += sgn * h
+            eq.last = (p, res.state)
+            vals.append(surface_misfit(eq(pp).positions, target, size)[0])
         return (vals[0] - vals[1]) / (2 * h)
 
-    for e in (0, 13, 27):
+    n = blend.n_edges
+    for e in (0, 13, 27, n + 0, n + 13, n + 27):
         fd = (4 * central(e, 5e-4) - central(e, 1e-3)) / 3  # Richardson, O(h^4)
         worst = max(worst, abs(g[e] - fd) / max(abs(fd), 1e-300))
     return worst
@@ -88,14 +97,17 @@ def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
 
 def lattice_case(name: str, pattern: str, target, iterations: int) -> None:  # type: ignore[no-untyped-def]
     lat = sinusoidal_lattice(n=5, spacing=5.0, amplitude=1.25, ghost_nodes=10, pattern=pattern)
-    t0 = time.perf_counter()
+    load = os.getloadavg()[0]
+    t0, c0 = time.perf_counter(), time.process_time()
     des = design_lattice(lat, target, max_iterations=iterations)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     _emit(
         case=name,
-        n_design_variables=len(des.modes),
+        n_design_variables=len(des.modes) + len(des.speeds),
         iterations=des.iterations,
         wall_s=round(wall, 3),
+        cpu_s=round(cpu, 3),
+        load_1min=round(load, 2),
         rms_error_rel=des.misfit_rel,
         target_metric=des.target_gaussian_curvature,
         achieved_metric=des.achieved_gaussian_curvature,
@@ -106,6 +118,7 @@ def lattice_case(name: str, pattern: str, target, iterations: int) -> None:  # t
         gradient_fd_rel_err=_fd_check(lat, target),
         stable=des.stable,
         forward_solves=des.solves,
+        speed_range_mm_s=[float(des.speeds.min()), float(des.speeds.max())],
     )
 
 

@@ -109,7 +109,7 @@ def test_print_programs_cover_the_network_and_keep_the_active_side(lattice):
     nodes = lattice.network.nodes
     alpha = lattice.interface_angle
     per = 11
-    for prog, line in zip(progs[:10], lattice._lines(), strict=True):
+    for prog, line in zip(progs[:10], lattice.line_edges, strict=True):
         chain = [lattice.edge_chains[e][:-1] for e in line] + [lattice.edge_chains[line[-1]][-1:]]
         np.testing.assert_allclose(prog.points[::4], nodes[np.concatenate(chain)], atol=1e-12)
         # program α averaged over each network segment matches the design α away from flips
@@ -126,3 +126,28 @@ def test_layers_parameter():
     lat = sinusoidal_lattice(n=3, ghost_nodes=3, layers=1)
     assert len(lat.print_programs()) == 6
     assert lat.network.n_nodes == 9 + 12 * 3
+
+
+def test_edge_speeds_set_the_speed_of_every_move_along_their_edge():
+    speeds = np.linspace(0.5, 3.0, 12)
+    lat = sinusoidal_lattice(n=3, ghost_nodes=4, edge_speeds=speeds)
+    assert np.array_equal(lat.speeds, speeds)
+    assert np.array_equal(sinusoidal_lattice(n=3, speed=2.0).speeds, np.full(12, 2.0))
+    for line, (prog, _), vertex_edges in zip(
+        lat.line_edges, lat.line_programs(), lat.line_speed_edges(), strict=True
+    ):
+        # a vertex carries the speed of the move leaving it: edge e's moves all at v_e
+        assert np.array_equal(prog.speed[:-1], np.repeat(speeds[line], 5))
+        assert np.array_equal(prog.speed, speeds[vertex_edges])
+    # toolpath resolution: the same speeds, four vertices per segment
+    assert np.array_equal(lat.print_programs(4)[0].speed[:-1], np.repeat(speeds[:2], 20))
+
+
+@pytest.mark.parametrize(
+    ("speeds", "field"),
+    [([1.0] * 11, "edge_speeds"), ([1.0] * 11 + [-2.0], r"edge_speeds\[11\]"),
+     ([1.0] * 11 + [np.nan], r"edge_speeds\[11\]"), (["a"] * 12, "edge_speeds")],
+)  # fmt: skip
+def test_bad_edge_speeds_name_the_field(speeds, field):
+    with pytest.raises(InvalidDesignError, match=field):
+        sinusoidal_lattice(n=3, ghost_nodes=4, edge_speeds=speeds)

@@ -6,17 +6,23 @@ import numpy as np
 import pytest
 
 from rotomorph.design.lattices import sinusoidal_lattice
-from rotomorph.errors import InvalidDesignError
+from rotomorph.errors import InvalidDesignError, InvalidParameterError
+from rotomorph.inverse.blend import with_settings
 from rotomorph.inverse.lattice import (
+    SOLVE_OPTIONS,
     _Equilibria,
     design_lattice,
     dome,
     height_map,
     lattice_blend,
     misfit_and_gradient,
+    saddle,
+    shape,
+    shape_misfit,
     surface_misfit,
 )
 from rotomorph.inverse.run import lattice_design_file
+from rotomorph.solve.newton import NewtonOptions
 
 
 @pytest.fixture(scope="module")
@@ -27,67 +33,55 @@ def small():
     return lat, lattice_blend(lat)
 
 
-def _gradient(blend, eq, c, target, size):
-    res = eq(c)
-    j, g = misfit_and_gradient(blend, c, res, target, size)
-    return j, g, res.state
-
-
-def test_misfit_gradient_matches_central_differences(small):
-    lat, _ = small
-    rng = np.random.default_rng(1)
-    x = lat.network.nodes.copy()
-    x[:, 2] = 0.02 * np.sum((x[:, :2] - 5.0) ** 2, axis=1) + rng.normal(0, 0.05, len(x))
-    x = x @ np.array([[1, 0, 0], [0, 0.96, -0.28], [0, 0.28, 0.96]]).T + 3.0  # tilted, moved
-    target = dome(0.05)
-    _, g, _ = surface_misfit(x, target, 10.0)
-    h = 1e-4
-    for i, k in [(3, 2), (20, 0), (40, 1)]:
-        xp, xm = x.copy(), x.copy()
-        xp[i, k] += h
-        xm[i, k] -= h
-        fd = (surface_misfit(xp, target, 10.0)[0] - surface_misfit(xm, target, 10.0)[0]) / (2 * h)
-        assert g[i, k] == pytest.approx(fd, rel=1e-4, abs=1e-10)
-
-
 def test_adjoint_gradient_matches_central_differences(small):
+    """Modes and speeds: the adjoint gradient against Richardson-extrapolated central
+    differences whose perturbed equilibria are solved to a relative residual of 1e-13."""
     lat, blend = small
     eq = _Equilibria(blend)
     rng = np.random.default_rng(3)
     base = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
     c = np.clip(0.7 * base + rng.uniform(-0.1, 0.1, blend.n_edges), -1, 1)
-    target = dome(0.04)
-    j, g, state = _gradient(blend, eq, c, target, 10.0)
+    p = np.concatenate([c, rng.uniform(1.0, 2.5, blend.n_edges)])
+    for target in (dome(0.04), saddle(0.04)):
+        eq.last = None
+        eq.options = SOLVE_OPTIONS
+        res = eq(p)
+        j, g = misfit_and_gradient(blend, p, res, target, 10.0)
+        eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
 
-    def central(e, h):
-        vals = []
-        for sgn in (1, -1):
-            cc = c.copy()
-            cc[e] += sgn * h
-            eq.last = (c, state)
-            vals.append(surface_misfit(eq(cc).positions, target, 10.0)[0])
-        return (vals[0] - vals[1]) / (2 * h)
+        def central(e, h, target=target, res=res):
+            vals = []
+            for sgn in (1, -1):
+                pp = p.copy()
+                pp[e] += sgn * h
+                eq.last = (p, res.state)
+                vals.append(surface_misfit(eq(pp).positions, target, 10.0)[0])
+            return (vals[0] - vals[1]) / (2 * h)
 
-    for e in (0, 5, 9):
-        # Richardson extrapolation of two central differences: O(h^4), above the solver noise
-        fd = (4 * central(e, 5e-4) - central(e, 1e-3)) / 3
-        assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
+        n = blend.n_edges
+        for e in (0, 9, n + 1, n + 8):
+            fd = (4 * central(e, 5e-4) - central(e, 1e-3)) / 3  # O(h^4)
+            assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
 
 
 def test_design_is_printable_verified_and_written_as_a_design_file():
     start = sinusoidal_lattice(
         n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
     )
-    des = design_lattice(start, dome(0.1), max_iterations=3)
+    des = design_lattice(start, dome(0.1), max_iterations=3, speed_resolution=0.1)
     finite = des.objective_history[np.isfinite(des.objective_history)]
     assert finite.min() < finite[0]  # the optimiser improved on the start
     assert set(np.unique(des.modes)) <= {-1.0, 1.0}
+    # printable speeds: multiples of the resolution inside the measured range
+    assert np.allclose(des.speeds / 0.1, np.round(des.speeds / 0.1))
+    assert des.speeds.min() >= 0.25 and des.speeds.max() <= 3.0
     assert des.stable
     file = lattice_design_file(des, "dome")
     assert file.lattice is not None and file.lattice.pattern == "custom"
     assert [m == "expanding" for m in file.lattice.edge_modes] == list(des.modes > 0)
-    # the written design is the verified one
+    # the written design is the verified one, speeds included
     assert file.lattice.to_lattice().edge_mode == des.lattice.edge_mode
+    assert np.allclose(file.lattice.to_lattice().speeds, des.speeds)
 
 
 def test_bad_lattice_targets_have_clear_errors(small):
@@ -102,30 +96,62 @@ def test_bad_lattice_targets_have_clear_errors(small):
         design_lattice(lat, height_map(x, x, np.outer(x, x)))
     with pytest.raises(InvalidDesignError, match="positive curvature"):
         dome(-0.1)
+    with pytest.raises(InvalidParameterError, match="speed_range"):
+        design_lattice(lat, dome(0.05), speed_range=(2.0, 1.0))
+    with pytest.raises(InvalidParameterError, match="speed_resolution"):
+        design_lattice(lat, dome(0.05), speed_resolution=0.0)
 
 
-def test_blend_at_printable_modes_is_the_printed_lattice_model(small):
-    """At c = ±1 the blend gives exactly the natural values the forward model builds."""
-    from rotomorph.lattice.actuation import DEFAULT_ACTUATION, get_actuation
+def test_blend_at_printable_settings_is_the_forward_actuation(small):
+    """At printable modes and any speeds the blend gives exactly the natural values the
+    forward model builds from the print programs."""
+    from rotomorph.lattice.actuation import ProgramActuation, default_stiffness
     from rotomorph.lattice.model import lattice_model
 
     lat, blend = small
-    act = get_actuation(DEFAULT_ACTUATION)
+    act = ProgramActuation()
+    stiffness, fm = default_stiffness(act)
     rng = np.random.default_rng(5)
-    for _ in range(3):
+    for _ in range(2):
         modes = rng.choice([-1.0, 1.0], blend.n_edges)
-        pattern = {e: ("expanding" if m > 0 else "contracting") for e, m in enumerate(modes)}
-        ref = act.natural(lattice_model(lattice_design(lat, pattern)), act.end)
-        k, rest = blend.natural(modes)
+        speeds = rng.uniform(0.25, 3.0, blend.n_edges)
+        printed = with_settings(lat, modes, speeds)
+        ref = act.natural(lattice_model(printed, stiffness=stiffness, filament_model=fm), act.end)
+        k, rest = blend.natural(modes, speeds)
         assert np.allclose(k, np.stack(ref.integrated_natural(), axis=1), atol=1e-12)
-        assert np.allclose(rest, ref.rest_length, atol=1e-12)
+        assert np.allclose(rest, ref.rest_length, rtol=1e-13)
+        assert np.allclose(ref.bending_stiffness1, blend.model.bending_stiffness1)
 
 
-def lattice_design(lat, pattern):
-    return sinusoidal_lattice(
-        n=lat.n,
-        spacing=lat.spacing,
-        amplitude=lat.amplitude,
-        ghost_nodes=lat.ghost_nodes,
-        pattern=pattern,
-    )
+def test_shape_misfit_gradient_and_rigid_invariance():
+    rng = np.random.default_rng(7)
+    y = rng.normal(size=(30, 3))
+    x = y + 0.05 * rng.normal(size=(30, 3))
+    j, g = shape_misfit(x, y, 4.0)
+    rot = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    assert shape_misfit(x @ rot.T + 2.0, y, 4.0)[0] == pytest.approx(j, rel=1e-12)
+    h = 1e-6
+    for i, k in [(0, 0), (7, 2), (29, 1)]:
+        xp, xm = x.copy(), x.copy()
+        xp[i, k] += h
+        xm[i, k] -= h
+        fd = (shape_misfit(xp, y, 4.0)[0] - shape_misfit(xm, y, 4.0)[0]) / (2 * h)
+        assert g[i, k] == pytest.approx(fd, rel=1e-6)
+
+
+def test_round_trip_recovers_a_hidden_program_from_the_shape():
+    """A lattice printed with a hidden pattern and hidden speeds is heated by the forward
+    simulation; a program recovered from its node positions alone, starting from a uniform
+    guess, heats (forward simulation again) into the same shape within 2 % of the size."""
+    from rotomorph.lattice.heating import heat_lattice
+
+    start = sinusoidal_lattice(n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6)
+    rng = np.random.default_rng(11)
+    m = len(start.edge_chains)
+    hidden = with_settings(start, rng.choice([-1.0, 1.0], m), rng.uniform(0.8, 3.0, m).round(2))
+    goal = heat_lattice(hidden, steps=8).positions[-1]
+    size = start.spacing * (start.n - 1)
+    des = design_lattice(start, shape(goal), nodes="all", max_iterations=15)
+    again = heat_lattice(des.lattice, steps=8).positions[-1]
+    rms = np.sqrt(2.0 * shape_misfit(again, goal, size)[0]) * size
+    assert rms / size < 0.02

@@ -95,3 +95,33 @@ def test_expanding_and_contracting_lattices_from_their_programs():
     assert grow.actuation == "program"
     assert grow.area_ratio[-1] > 1.15
     assert shrink.area_ratio[-1] < 0.9
+
+
+def test_per_edge_speeds_need_the_program_actuation():
+    """'thermal' and 'additive' use one Janus curvature: mixed edge speeds are refused, and
+    'program' gives a slower edge a weaker actuation."""
+    from rotomorph.design.lattices import sinusoidal_lattice
+    from rotomorph.errors import InvalidParameterError
+    from rotomorph.lattice.actuation import ProgramActuation, ThermalActuation
+    from rotomorph.lattice.model import lattice_model
+
+    speeds = [3.0] * 11 + [0.5]
+    lm = lattice_model(sinusoidal_lattice(n=3, ghost_nodes=4, edge_speeds=speeds))
+    with pytest.raises(InvalidParameterError, match="per-edge speeds needs actuation 'program'"):
+        ThermalActuation().natural(lm, 175.0)
+    uniform = lattice_model(sinusoidal_lattice(n=3, ghost_nodes=4))
+    act = ProgramActuation()
+
+    def increment(m):
+        nat = act.natural(m, 175.0)
+        return np.hypot(
+            nat.natural_curvature1 - m.printed[0], nat.natural_curvature2 - m.printed[1]
+        )
+
+    st = lm.model.stencils
+    inner = (st.edge_e >= 55) & (st.edge_f >= 55)  # stencils inside edge 11 (segments 55-59)
+    assert inner.sum() == 4
+    assert np.all(increment(lm)[inner] < 0.5 * increment(uniform)[inner])
+    assert np.allclose(
+        increment(lm)[~inner & (st.edge_e < 50)], increment(uniform)[~inner & (st.edge_e < 50)]
+    )

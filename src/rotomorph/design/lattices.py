@@ -114,6 +114,21 @@ def _modes(pattern: Pattern, n: int, edges: IntArray, centre: str) -> tuple[str,
     return modes
 
 
+def _edge_speeds(values: Sequence[float], m: int) -> tuple[float, ...]:
+    try:
+        speeds = np.asarray(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InvalidDesignError("edge_speeds", "must be a list of numbers (mm/s)") from None
+    if speeds.shape != (m,):
+        raise InvalidDesignError(
+            "edge_speeds", f"needs one speed per lattice edge ({m}); got {speeds.size}"
+        )
+    for e, v in enumerate(speeds):
+        if not (np.isfinite(v) and v > 0):
+            raise InvalidDesignError(f"edge_speeds[{e}]", f"must be > 0 mm/s; got {v}")
+    return tuple(float(v) for v in speeds)
+
+
 @compact_display()
 @dataclass(frozen=True, eq=False)
 class Lattice:
@@ -141,6 +156,10 @@ class Lattice:
         Arc length (mm) over which the nozzle turns the active side by π at each inflection
         (0: a step, the ideal sharp flip; a machine with rotation limit ω_max needs at least
         π v / ω_max).
+    edge_speeds
+        Print speed of each lattice edge ``(E,)`` (mm/s), or None for ``speed`` everywhere
+        (:attr:`speeds`). The speed sets how strongly an edge actuates (the calibrated speed
+        law of :mod:`rotomorph.materials.process`).
 
     Notes
     -----
@@ -164,6 +183,7 @@ class Lattice:
     active_material: str = "lce"
     passive_material: str = "acrylate"
     flip_length: float = 0.0
+    edge_speeds: tuple[float, ...] | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     # ----------------------------------------------------------------- branch nodes
@@ -196,6 +216,13 @@ class Lattice:
         return tuple("y" if b - a == 1 else "x" for a, b in e)
 
     # ----------------------------------------------------------------- printing
+    @property
+    def speeds(self) -> FloatArray:
+        """Print speed of every lattice edge ``(E,)`` (mm/s): ``edge_speeds`` or ``speed``."""
+        if self.edge_speeds is None:
+            return np.full(len(self.edge_nodes), self.speed)
+        return np.array(self.edge_speeds, dtype=float)
+
     def _lines(self) -> list[list[int]]:
         """Lattice edges grouped into continuous filaments: x-lines by j, then y-lines by i."""
         m = self.n - 1
@@ -217,6 +244,23 @@ class Lattice:
             + np.outer(s * self.spacing / per, t)
             + np.outer(self.amplitude * np.sin(2 * np.pi * s / per), nrm)
         )
+
+    @property
+    def line_edges(self) -> list[list[int]]:
+        """Lattice edges of every printed line, in printing order (x-lines by j, then y-lines
+        by i)."""
+        return self._lines()
+
+    def _vertex_edges(self, line: list[int], subdivide: int) -> IntArray:
+        """Lattice edge whose speed each vertex of a line's program carries: that of the move
+        leaving it (the last vertex: its edge's)."""
+        per_edge = (self.ghost_nodes + 1) * subdivide
+        return np.append(np.repeat(np.asarray(line, dtype=np.int64), per_edge), line[-1])
+
+    def line_speed_edges(self) -> list[IntArray]:
+        """Per printed line (as :meth:`line_programs`), the lattice edge whose speed each of its
+        program vertices carries (:attr:`speeds` indexed by it gives the vertex speeds)."""
+        return [self._vertex_edges(line, 1) for line in self._lines()]
 
     def line_programs(self) -> list[tuple[PrintProgram, IntArray]]:
         """The printed lines of one layer at network resolution, with their segments.
@@ -248,7 +292,9 @@ class Lattice:
         -----
         Each line's nozzle keeps the active half outer (expanding edges) or inner (contracting
         edges) of the local curvature, flipping by π at inflections (see
-        :meth:`PrintProgram.sinusoid_with_active_side`); layer ``k`` lies at
+        :meth:`PrintProgram.sinusoid_with_active_side`). Every move along lattice edge ``e``
+        runs at ``speeds[e]``: a vertex carries the speed of the move that leaves it (the
+        branch node between two edges that of the next edge). Layer ``k`` lies at
         ``z = k * layer_height`` (mm). Lines are printed x-lines (by j) then y-lines (by i), each
         in +x / +y.
         """
@@ -257,6 +303,7 @@ class Lattice:
         key = ("programs", int(subdivide))
         if key not in self._cache:
             base = []
+            edge_speed = self.speeds
             for line in self._lines():
                 pieces = [self._edge_points(line[0], subdivide)[:1]]
                 side = [1.0 if self.edge_mode[line[0]] == "expanding" else -1.0]
@@ -265,12 +312,13 @@ class Lattice:
                     pieces.append(pts)
                     sgn = 1.0 if self.edge_mode[e] == "expanding" else -1.0
                     side.extend([sgn] * len(pts))
+                speed = edge_speed[self._vertex_edges(line, subdivide)]
                 path = Path(np.concatenate(pieces))
                 alpha = active_side_angle(path, np.array(side), self.flip_length)
                 base.append(
                     PrintProgram.from_interface_angle(
                         path,
-                        self.speed,
+                        speed if self.edge_speeds is not None else self.speed,
                         alpha,
                         radius=self.radius,
                         active_fraction=self.active_fraction,
@@ -339,6 +387,7 @@ def sinusoidal_lattice(
     active_material: str = "lce",
     passive_material: str = "acrylate",
     flip_length: float = 0.0,
+    edge_speeds: Sequence[float] | None = None,
 ) -> Lattice:
     """The paper's n × n lattice of one-period sinusoidal edges (module docstring).
 
@@ -366,6 +415,9 @@ def sinusoidal_lattice(
         Printing parameters: v (mm/s), R (mm), active area fraction, material names.
     flip_length
         Arc length (mm, >= 0) of each π flip of the active side (0: a step).
+    edge_speeds
+        One print speed per lattice edge (mm/s, each > 0), in edge order; default ``speed``
+        on every edge.
 
     Raises
     ------
@@ -393,6 +445,7 @@ def sinusoidal_lattice(
     n, ghost_nodes, layers = int(n), int(ghost_nodes), int(layers)
     edges = _edge_list(n)
     modes = _modes(pattern, n, edges, centre)
+    speeds = None if edge_speeds is None else _edge_speeds(edge_speeds, len(edges))
     ii, jj = np.divmod(np.arange(n * n), n)
     branch_xyz = np.column_stack([spacing * ii, spacing * jj, np.zeros(n * n)])
     s = np.arange(1, ghost_nodes + 1, dtype=float)
@@ -433,4 +486,5 @@ def sinusoidal_lattice(
         active_material,
         passive_material,
         float(flip_length),
+        speeds,
     )

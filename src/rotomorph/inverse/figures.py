@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from rotomorph.inverse.filament import FilamentDesign
-from rotomorph.inverse.lattice import LatticeDesign, surface_misfit
+from rotomorph.inverse.lattice import LatticeDesign, SurfaceTarget, surface_misfit
 from rotomorph.plot.figure import new_figure, save_figure
 
 __all__ = ["inverse_figures"]
@@ -62,21 +62,54 @@ def _filament(design: FilamentDesign, folder: Path) -> list[Path]:
 def _lattice(design: LatticeDesign, folder: Path) -> list[Path]:
     out = []
     lat = design.lattice
+    if isinstance(design.target, SurfaceTarget):
+        out.append(_on_surface(design, design.target, folder))
+    fig = new_figure(6, 4, dpi=150)
+    ax = fig.add_subplot(1, 1, 1)
+    h = design.objective_history
+    ax.semilogy(np.arange(1, len(h) + 1), np.where(np.isfinite(h), h, np.nan), "o-", ms=3)
+    ax.set_xlabel("objective evaluation")
+    ax.set_ylabel("objective J")
+    ax.grid(alpha=0.3, which="both")
+    ax.set_title("convergence of the adjoint optimisation")
+    fig.tight_layout()
+    out.append(save_figure(fig, folder / "objective.png"))
+    fig = new_figure(5.5, 5.5, dpi=150)
+    ax = fig.add_subplot(1, 1, 1)
+    ref = lat.network.nodes
+    speeds = design.speeds
+    for e, chain in enumerate(lat.edge_chains):
+        width = 0.5 + 3.5 * speeds[e] / max(float(speeds.max()), 1e-9)
+        ax.plot(*ref[chain, :2].T, color="tab:red" if design.modes[e] > 0 else "tab:blue", lw=width)
+    ax.set_aspect("equal")
+    ax.set_title(
+        "printed pattern: red expanding, blue contracting\n"
+        f"line width ∝ print speed ({speeds.min():.2f}–{speeds.max():.2f} mm/s)"
+    )
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    fig.tight_layout()
+    out.append(save_figure(fig, folder / "pattern.png"))
+    return out
+
+
+def _on_surface(design: LatticeDesign, target: SurfaceTarget, folder: Path) -> Path:
+    lat = design.lattice
     size = lat.spacing * (lat.n - 1)
-    _, _, p = surface_misfit(design.positions, design.target, size)
+    _, _, p = surface_misfit(design.positions, target, size)
     from scipy.spatial.transform import Rotation
 
     x = design.positions
     y = Rotation.from_rotvec(p[:3]).apply(x - x.mean(axis=0))
     y[:, 2] += p[3]
-    z_t, _, _ = design.target.height(y[:, 0], y[:, 1])
+    z_t, _, _ = target.height(y[:, 0], y[:, 1])
     err = y[:, 2] - z_t
     fig = new_figure(13, 5, dpi=150)
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     gx = np.linspace(y[:, 0].min(), y[:, 0].max(), 30)
     gy = np.linspace(y[:, 1].min(), y[:, 1].max(), 30)
     mx, my = np.meshgrid(gx, gy, indexing="ij")
-    mz, _, _ = design.target.height(mx, my)
+    mz, _, _ = target.height(mx, my)
     ax.plot_surface(mx, my, mz, color="0.75", alpha=0.35, linewidth=0)
     for a, b in lat.network.edges:
         ax.plot(*y[[a, b]].T, color="k", lw=0.8)
@@ -91,29 +124,7 @@ def _lattice(design: LatticeDesign, folder: Path) -> list[Path]:
     ax2.set_title(f"height error (mm), RMS {design.misfit_rms:.3g} mm")
     fig.colorbar(sc, ax=ax2, shrink=0.8)
     fig.tight_layout()
-    out.append(save_figure(fig, folder / "target_vs_achieved.png"))
-    fig = new_figure(6, 4, dpi=150)
-    ax = fig.add_subplot(1, 1, 1)
-    h = design.objective_history
-    ax.semilogy(np.arange(1, len(h) + 1), np.where(np.isfinite(h), h, np.nan), "o-", ms=3)
-    ax.set_xlabel("objective evaluation")
-    ax.set_ylabel("objective J")
-    ax.grid(alpha=0.3, which="both")
-    ax.set_title("convergence of the adjoint optimisation")
-    fig.tight_layout()
-    out.append(save_figure(fig, folder / "objective.png"))
-    fig = new_figure(5.5, 5.5, dpi=150)
-    ax = fig.add_subplot(1, 1, 1)
-    ref = lat.network.nodes
-    for e, chain in enumerate(lat.edge_chains):
-        ax.plot(*ref[chain, :2].T, color="tab:red" if design.modes[e] > 0 else "tab:blue", lw=2)
-    ax.set_aspect("equal")
-    ax.set_title("printed pattern: red expanding, blue contracting")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    fig.tight_layout()
-    out.append(save_figure(fig, folder / "pattern.png"))
-    return out
+    return save_figure(fig, folder / "target_vs_achieved.png")
 
 
 def inverse_figures(result: FilamentDesign | LatticeDesign, folder: str | Path) -> list[Path]:

@@ -1,15 +1,16 @@
-r"""Inverse design of a lattice: which edges expand and which contract so that it rises into a
-target surface.
+r"""Inverse design of a lattice: which edges expand or contract, and how fast each is printed,
+so that it rises into a target surface.
 
 Design variables
 ----------------
-One continuous variable :math:`c_e \in [-1, 1]` per lattice edge: :math:`+1` is an expanding
-edge (active half on the outer side of the wave), :math:`-1` a contracting one (active half
-inner). In between, the edge's natural values (integrated curvatures and twist of its own
-stencils, rest lengths of its segments) are the linear blend of the two printable ones, which
-is the continuous relaxation the gradient phase needs; the result is rounded to the printable
-values :math:`\pm 1` and re-verified by a fresh forward solve. Junction stencils keep their
-printed values in both modes.
+Per lattice edge a mode :math:`c_e \in [-1, 1]` (:math:`+1` expanding, active half on the
+outer side of the wave; :math:`-1` contracting) and a print speed :math:`v_e` (mm/s) within
+the allowed range. :mod:`rotomorph.inverse.blend` gives the natural values (integrated
+curvatures and twist per stencil, rest lengths per segment) as smooth functions of both: the
+linear blend of the two printable modes, and the speed through the calibrated speed law, equal
+to the forward ``program`` actuation at printable modes. After the gradient phase the modes are
+rounded to :math:`\pm 1`, the speeds re-optimised with the modes fixed and rounded to the
+printable speed resolution, and the design is re-verified by a fresh forward solve.
 
 Objective
 ---------
@@ -24,18 +25,18 @@ compared with a target surface :math:`z = f(x, y)`:
 
 with :math:`L` the lattice size and :math:`\beta` a small weight that favours printable values.
 By the envelope theorem the gradient of the aligned misfit with respect to the node positions
-is that of the residuals at the optimal alignment. The gradient with respect to :math:`c` comes
-from one adjoint solve (:mod:`rotomorph.inverse.adjoint`), and SciPy's L-BFGS-B handles the box
-:math:`[-1, 1]`. Every equilibrium is warm-started from the previous one; a design whose
-equilibrium is not a stable minimum is rejected by the line search (its objective is
-infinite).
+is that of the residuals at the optimal alignment. A :class:`ShapeTarget` (node positions of
+the same lattice) is compared node by node after the best rotation (Kabsch) instead. The
+gradient with respect to all design variables comes from one adjoint solve
+(:mod:`rotomorph.inverse.adjoint`), and SciPy's L-BFGS-B handles the bounds. Every
+equilibrium is warm-started from the previous one; a design whose equilibrium is not a stable
+minimum is rejected by the line search (its objective is infinite).
 """
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -45,12 +46,12 @@ from scipy.spatial.transform import Rotation
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.curvature import fit_quadratic_surface
-from rotomorph.design.lattices import Lattice, sinusoidal_lattice
+from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidDesignError, InvalidParameterError
 from rotomorph.inverse.adjoint import NotAMinimumError, adjoint
-from rotomorph.lattice.actuation import Actuation, get_actuation
+from rotomorph.inverse.blend import LatticeBlend, lattice_blend, with_settings
+from rotomorph.lattice.actuation import Actuation
 from rotomorph.lattice.heating import perturbed_state, symmetry_breaking
-from rotomorph.lattice.model import lattice_model
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
 from rotomorph.solve.continuation import continuation
@@ -58,14 +59,20 @@ from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.static import StaticResult, solve_static
 
 __all__ = [
+    "MEASURED_SPEEDS",
     "LatticeBlend",
     "LatticeDesign",
+    "ShapeTarget",
     "SurfaceTarget",
     "design_lattice",
     "dome",
     "height_map",
+    "lattice_blend",
     "misfit_and_gradient",
     "saddle",
+    "shape",
+    "shape_misfit",
+    "split",
     "surface_misfit",
 ]
 
@@ -159,6 +166,37 @@ def height_map(x: FloatArray, y: FloatArray, z: FloatArray) -> SurfaceTarget:
     return target
 
 
+@dataclass(frozen=True, eq=False)
+class ShapeTarget:
+    """A lattice shape given by the positions of all its nodes ``(N, 3)`` (mm), e.g. a measured
+    or simulated lattice, compared node by node after the best rigid alignment.
+
+    Attributes
+    ----------
+    positions
+        Target node positions, in the lattice's node order (mm).
+    description
+        Human-readable summary.
+    """
+
+    positions: FloatArray
+    description: str = "lattice shape"
+    kind: Literal["shape"] = "shape"
+    gaussian_curvature: float | None = None
+    characteristic_curvature: float | None = None
+
+
+def shape(positions: FloatArray) -> ShapeTarget:
+    """A :class:`ShapeTarget` from node positions ``(N, 3)`` (mm)."""
+    x = np.array(positions, dtype=float)
+    if x.ndim != 2 or x.shape[1] != 3 or len(x) < 3 or not np.all(np.isfinite(x)):
+        raise InvalidDesignError(
+            "target.positions", f"must be finite node positions (N >= 3, 3); got {x.shape}"
+        )
+    x.setflags(write=False)
+    return ShapeTarget(x, f"lattice shape of {len(x)} nodes")
+
+
 # ---------------------------------------------------------------------------------- misfit
 def _rigid(params: FloatArray, x: FloatArray) -> FloatArray:
     y = Rotation.from_rotvec(params[:3]).apply(x)
@@ -215,203 +253,41 @@ def surface_misfit(
     return j, grad, p
 
 
-# ---------------------------------------------------------------------------------- blend
-def _integrated_factor(model: Model) -> FloatArray:
-    ones = np.ones(model.stencils.count)
-    return np.asarray(model.with_natural(curvature1=ones).integrated_natural()[0])
+def shape_misfit(
+    positions: FloatArray, target: FloatArray, size: float
+) -> tuple[float, FloatArray]:
+    """Misfit ``J = sum_i |R x'_i - y'_i|² / (2 N size²)`` of nodes ``positions`` to
+    ``target`` (both ``(N, 3)``, mm; primes: centred) at the best rotation R (Kabsch), and its
+    gradient ``(N, 3)`` w.r.t. ``positions`` (1/mm²·mm).
 
-
-@dataclass(frozen=True, eq=False)
-class LatticeBlend:
-    """Natural values of a lattice as a function of per-edge design variables ``c``.
-
-    Stencils inside one lattice edge depend on that edge's mode only: their natural values are
-    the linear blend ``w+(c) K[+] + w-(c) K[-]`` with ``w±(c) = (1 ± c)/2`` of the values of the
-    printable modes. Junction stencils couple two edges ``e, f`` (a printed line passing through
-    a node, or a crossing) and may depend on both modes: their values are the bilinear blend of
-    the four printable combinations. Rest lengths belong to one edge each.
-
-    Attributes
-    ----------
-    lattice
-        The printed geometry (its own pattern is irrelevant).
-    model
-        The printed rod model (zero actuation).
-    printed
-        Integrated natural values ``(S, 3)`` and rest lengths ``(E,)`` of the printed state.
-    combos
-        ``(S, 2, 2, 3)``: fully actuated integrated naturals of every stencil for its two edges'
-        modes ``[mode of edge_a, mode of edge_b]`` (index 0 expanding, 1 contracting).
-    rest
-        ``(2, E)``: fully actuated rest lengths for each mode.
-    stencil_edges
-        ``(S, 2)`` lattice edges ``(a, b)`` of each stencil's two segments (equal inside an edge).
-    segment_edge
-        Lattice edge of every network segment ``(E,)``.
+    J is exactly invariant under rigid motions of ``positions``; by the envelope theorem its
+    gradient is ``R^T (R x'_i - y'_i) / (N size²)`` (the centring drops out: both residual
+    sums vanish).
     """
-
-    lattice: Lattice
-    model: Model
-    printed: tuple[FloatArray, FloatArray]
-    combos: FloatArray
-    rest: FloatArray
-    stencil_edges: IntArray
-    segment_edge: IntArray
-    factor: FloatArray = field(repr=False)
-
-    @property
-    def n_edges(self) -> int:
-        """Number of lattice edges (design variables)."""
-        return len(self.lattice.edge_chains)
-
-    def _weights(self, c: FloatArray) -> tuple[FloatArray, FloatArray]:
-        c = np.asarray(c, dtype=float)
-        ca, cb = c[self.stencil_edges[:, 0]], c[self.stencil_edges[:, 1]]
-        wa = np.stack([0.5 * (1 + ca), 0.5 * (1 - ca)], axis=1)
-        wb = np.stack([0.5 * (1 + cb), 0.5 * (1 - cb)], axis=1)
-        return wa, wb
-
-    def natural(self, c: FloatArray, t: float = 1.0) -> tuple[FloatArray, FloatArray]:
-        """Integrated naturals ``(S, 3)`` and rest lengths ``(E,)`` at design ``c`` and ramp
-        fraction ``t`` (0 = printed, 1 = fully actuated)."""
-        wa, wb = self._weights(c)
-        full = np.einsum("si,sj,sijk->sk", wa, wb, self.combos)
-        k0, l0 = self.printed
-        cs = np.asarray(c, dtype=float)[self.segment_edge]
-        rest_full = 0.5 * (1 + cs) * self.rest[0] + 0.5 * (1 - cs) * self.rest[1]
-        return k0 + t * (full - k0), l0 + t * (rest_full - l0)
-
-    def gradient(
-        self, c: FloatArray, products: FloatArray, rest_products: FloatArray
-    ) -> FloatArray:
-        """``d/dc`` of ``sum(products * naturals) + sum(rest_products * rest)`` at t = 1.
-
-        ``products`` ``(S, 3)`` and ``rest_products`` ``(E,)`` are e.g. the adjoint products
-        ``lambda^T dg/d(natural)`` of :func:`rotomorph.rod.sensitivity.natural_sensitivity`.
-        """
-        wa, wb = self._weights(c)
-        dw = np.array([0.5, -0.5])
-        da = np.einsum("i,sj,sijk->sk", dw, wb, self.combos)  # d(naturals)/dc_a
-        db = np.einsum("si,j,sijk->sk", wa, dw, self.combos)  # d(naturals)/dc_b
-        g = np.zeros(self.n_edges)
-        np.add.at(g, self.stencil_edges[:, 0], np.sum(products * da, axis=1))
-        np.add.at(g, self.stencil_edges[:, 1], np.sum(products * db, axis=1))
-        np.add.at(g, self.segment_edge, rest_products * 0.5 * (self.rest[0] - self.rest[1]))
-        return g
-
-    def rod(self, c: FloatArray, t: float = 1.0) -> Model:
-        """The rod model at design ``c`` and ramp fraction ``t``."""
-        k, rest = self.natural(c, t)
-        trial = self.model.with_natural(rest_length=rest)
-        return trial.with_natural(
-            curvature1=k[:, 0] / self.factor,
-            curvature2=k[:, 1] / self.factor,
-            twist=k[:, 2] / self.factor,
-        )
+    x = np.asarray(positions, dtype=float)
+    y = np.asarray(target, dtype=float)
+    xc, yc = x - x.mean(axis=0), y - y.mean(axis=0)
+    u, _, vt = np.linalg.svd(xc.T @ yc)
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    r = xc @ rot.T - yc
+    n = len(x)
+    j = 0.5 * float(np.sum(r * r)) / (n * size * size)
+    return j, (r @ rot) / (n * size * size)
 
 
-def _values(model: Model) -> tuple[FloatArray, FloatArray]:
-    k1, k2, tw = model.integrated_natural()
-    return np.stack([k1, k2, tw], axis=1), np.array(model.rest_length, dtype=float)
-
-
-def lattice_blend(
-    lattice: Lattice, actuation: str | Actuation | None = None, *, seed: int = 0
-) -> LatticeBlend:
-    """Build the :class:`LatticeBlend` of ``lattice`` for an actuation mode (default: the
-    package's default lattice actuation) at its full actuation.
-
-    The four mode combinations of every junction stencil are read off fully actuated lattices
-    of a few patterns (uniform ones, then random ones until every combination is seen); a
-    combination seen in two patterns must give the same values, else the actuation is not
-    local to the two edges and the blend refuses it.
-    """
-    act = get_actuation(actuation) if actuation is not None else _default_actuation()
-    net = lattice.network
-    seg_lookup = {}
-    for j, (a, b) in enumerate(net.edges):
-        seg_lookup[(int(min(a, b)), int(max(a, b)))] = j
-    segment_edge = np.full(net.n_edges, -1, dtype=np.int64)
-    for e, chain in enumerate(lattice.edge_chains):
-        for a, b in itertools.pairwise(chain):
-            segment_edge[seg_lookup[(int(min(a, b)), int(max(a, b)))]] = e
-    base = lattice_model(lattice).model
-    st = base.stencils
-    pairs = np.stack([segment_edge[st.edge_e], segment_edge[st.edge_f]], axis=1)
-    n_edges = len(lattice.edge_chains)
-    combos = np.full((st.count, 2, 2, 3), np.nan)
-    rest = np.full((2, net.n_edges), np.nan)
-    printed = None
-    rng = np.random.default_rng(seed)
-    same = pairs[:, 0] == pairs[:, 1]
-    patterns = [np.zeros(n_edges, dtype=int), np.ones(n_edges, dtype=int)]
-    for _ in range(24):
-        if patterns:
-            modes = patterns.pop(0)
-        elif not (np.isnan(combos[~same]).any() or np.isnan(rest).any()):
-            break
-        else:
-            modes = rng.integers(0, 2, n_edges)
-        lat = _with_pattern(
-            lattice, {e: ("expanding", "contracting")[int(m)] for e, m in enumerate(modes)}
-        )
-        lm = lattice_model(lat)
-        if printed is None:
-            printed = _values(act.natural(lm, act.start))
-        k, r = _values(act.natural(lm, act.end))
-        ia, ib = modes[pairs[:, 0]], modes[pairs[:, 1]]
-        seen = combos[np.arange(st.count), ia, ib]
-        known = ~np.isnan(seen[:, 0])
-        if np.any(np.abs(seen[known] - k[known]) > 1e-9 * (1 + np.abs(k[known]))):
-            raise InvalidParameterError(
-                "actuation",
-                f"{act.name!r} is not local to the two edges of a junction; inverse design "
-                "needs an actuation whose natural values depend on each edge's own mode",
-            )
-        combos[np.arange(st.count), ia, ib] = k
-        rest[modes[segment_edge], np.arange(net.n_edges)] = r
-    # inside one edge both modes move together: the off-diagonal combinations are the mean of
-    # the diagonal ones, which makes the bilinear blend linear there (w+ + w- = 1)
-    mean = 0.5 * (combos[same, 0, 0] + combos[same, 1, 1])
-    combos[same, 0, 1] = mean
-    combos[same, 1, 0] = mean
-    if np.isnan(combos).any() or np.isnan(rest).any() or printed is None:
-        raise InvalidParameterError("lattice", "could not sample every mode combination")
-    printed_model = act.natural(lattice_model(lattice), act.start)
-    return LatticeBlend(
-        lattice=lattice,
-        model=printed_model,
-        printed=printed,
-        combos=combos,
-        rest=rest,
-        stencil_edges=pairs,
-        segment_edge=segment_edge,
-        factor=_integrated_factor(printed_model),
-    )
-
-
-def _default_actuation() -> Actuation:
-    from rotomorph.lattice import actuation as mod
-
-    default = getattr(mod, "DEFAULT_ACTUATION", None)
-    return get_actuation(default if default is not None else "swapped")
-
-
-def _with_pattern(lattice: Lattice, pattern: Any) -> Lattice:
-    return sinusoidal_lattice(
-        n=lattice.n,
-        spacing=lattice.spacing,
-        amplitude=lattice.amplitude,
-        ghost_nodes=lattice.ghost_nodes,
-        pattern=pattern,
-        layers=lattice.layers,
-        layer_height=lattice.layer_height,
-        speed=lattice.speed,
-        radius=lattice.radius,
-        active_fraction=lattice.active_fraction,
-        active_material=lattice.active_material,
-        passive_material=lattice.passive_material,
-    )
+def _misfit(
+    target: SurfaceTarget | ShapeTarget, positions: FloatArray, picked: IntArray, size: float
+) -> tuple[float, FloatArray]:
+    """Misfit and gradient ``(N, 3)`` (zero off ``picked``) of any lattice target."""
+    x = np.asarray(positions)
+    grad = np.zeros_like(x, dtype=float)
+    if isinstance(target, ShapeTarget):
+        j, g = shape_misfit(x[picked], target.positions[picked], size)
+    else:
+        j, g, _ = surface_misfit(x[picked], target, size)
+    grad[picked] = g
+    return j, grad
 
 
 # ---------------------------------------------------------------------------------- solve
@@ -425,7 +301,8 @@ def _is_minimum(model: Model, state: State) -> bool:
 
 
 class _Equilibria:
-    """Forward solves with warm starts (continuation in the ramp from the flat state first).
+    """Forward solves of designs ``p = (c, v)`` with warm starts (continuation in the ramp
+    from the flat state first).
 
     A ramp that ends on an unstable equilibrium (a flat state past its buckling point, kept
     by symmetry) is repeated from a larger out-of-plane perturbation, up to ``retries`` times.
@@ -440,20 +317,29 @@ class _Equilibria:
         self.retries = retries
         self.last: tuple[FloatArray, State] | None = None
         self.solves = 0
+        self.options = SOLVE_OPTIONS
+
+    def rod(self, p: FloatArray, t: float = 1.0) -> Model:
+        """The rod model of design ``p`` at ramp fraction ``t``."""
+        c, v = split(self.blend, p)
+        return self.blend.rod(c, v, t)
+
+    def _solve(self, model: Model, state: State) -> StaticResult:
+        self.solves += 1
+        return solve_static(model, initial=state, options=self.options)
 
     def _flat(self, scale: float) -> State:
         lat = self.blend.lattice
         dz = symmetry_breaking(lat, scale * self.perturbation * lat.spacing, self.seed)
         return perturbed_state(self.blend.model, dz)
 
-    def _ramp(self, c: FloatArray) -> StaticResult:
+    def _ramp(self, p: FloatArray) -> StaticResult:
         def solve(t: float, state: State) -> StaticResult:
-            self.solves += 1
-            return solve_static(self.blend.rod(c, t), initial=state, options=SOLVE_OPTIONS)
+            return self._solve(self.rod(p, t), state)
 
         path = continuation(solve, np.linspace(0.1, 1.0, 10), self._flat(1.0), start=0.0)
         res = path.results[-1]
-        model = self.blend.rod(c)
+        model = self.rod(p)
         lat = self.blend.lattice
         for k in range(self.retries):
             if _is_minimum(model, res.state):
@@ -464,32 +350,35 @@ class _Equilibria:
             start = perturbed_state(
                 model, start.positions - lat.network.nodes + kick[:, None] * [0.0, 0.0, 1.0]
             )
-            self.solves += 1
-            res = solve_static(model, initial=start, options=SOLVE_OPTIONS)
+            res = self._solve(model, start)
         return res
 
-    def __call__(self, c: FloatArray) -> StaticResult:
-        c = np.asarray(c, dtype=float).copy()
+    def __call__(self, p: FloatArray) -> StaticResult:
+        p = np.asarray(p, dtype=float).copy()
         if self.last is not None:
-            c_prev, state = self.last
+            p_prev, state = self.last
             try:
-                self.solves += 1
-                res = solve_static(self.blend.rod(c), initial=state, options=SOLVE_OPTIONS)
+                res = self._solve(self.rod(p), state)
             except ConvergenceError:
-                res = self._between(c_prev, c, state)
+                res = self._between(p_prev, p, state)
         else:
-            res = self._ramp(c)
-        self.last = (c, res.state)
+            res = self._ramp(p)
+        self.last = (p, res.state)
         return res
 
-    def _between(self, c0: FloatArray, c1: FloatArray, state: State) -> StaticResult:
+    def _between(self, p0: FloatArray, p1: FloatArray, state: State) -> StaticResult:
         def solve(u: float, st: State) -> StaticResult:
-            self.solves += 1
-            c = (1 - u) * c0 + u * c1
-            return solve_static(self.blend.rod(c), initial=st, options=SOLVE_OPTIONS)
+            return self._solve(self.rod((1 - u) * p0 + u * p1), st)
 
         path = continuation(solve, np.linspace(0.25, 1.0, 4), state, start=0.0)
         return path.results[-1]
+
+
+def split(blend: LatticeBlend, p: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Modes ``c`` and speeds ``v`` (mm/s) of a design vector ``p = (c, v)`` ``(2 E,)``."""
+    p = np.asarray(p, dtype=float)
+    n = blend.n_edges
+    return p[:n], p[n:]
 
 
 @dataclass(frozen=True, eq=False)
@@ -499,11 +388,15 @@ class LatticeDesign:
     Attributes
     ----------
     lattice
-        The designed, printable lattice (each edge ``expanding`` or ``contracting``).
+        The designed, printable lattice (each edge ``expanding`` or ``contracting``, printed
+        at its own speed).
     relaxed
-        Continuous design ``(E,)`` at the end of the gradient phase.
+        Continuous design ``(2 E,)`` (modes, then speeds in mm/s) at the end of the gradient
+        phase.
     modes
-        Printable design ``(E,)`` of ±1 after rounding.
+        Printable modes ``(E,)`` of ±1 after rounding.
+    speeds
+        Printable speeds ``(E,)`` (mm/s) after rounding to the speed resolution.
     positions
         Verified equilibrium of the rounded design ``(N, 3)`` (mm).
     target
@@ -525,8 +418,9 @@ class LatticeDesign:
     lattice: Lattice
     relaxed: FloatArray
     modes: FloatArray
+    speeds: FloatArray
     positions: FloatArray
-    target: SurfaceTarget
+    target: SurfaceTarget | ShapeTarget
     objective_history: FloatArray
     misfit_rms: float
     misfit_rel: float
@@ -544,13 +438,14 @@ class LatticeDesign:
 
 def misfit_and_gradient(
     blend: LatticeBlend,
-    c: FloatArray,
+    p: FloatArray,
     result: StaticResult,
-    target: SurfaceTarget,
+    target: SurfaceTarget | ShapeTarget,
     size: float,
     nodes: IntArray | None = None,
 ) -> tuple[float, FloatArray]:
-    """Aligned misfit ``J`` of the equilibrium ``result`` of design ``c`` and ``dJ/dc`` ``(E,)``.
+    """Aligned misfit ``J`` of the equilibrium ``result`` of design ``p = (c, v)`` and
+    ``dJ/dp`` ``(2 E,)`` (per unit mode, then per mm/s).
 
     One adjoint solve at the equilibrium (:func:`rotomorph.inverse.adjoint.adjoint`), whatever
     the number of edges; ``nodes`` (default all) are the nodes compared with the target.
@@ -561,19 +456,19 @@ def misfit_and_gradient(
         The equilibrium is not a stable minimum.
     """
     picked = np.arange(len(result.positions)) if nodes is None else np.asarray(nodes)
-    j, gsel, _ = surface_misfit(result.positions[picked], target, size)
-    gx = np.zeros_like(result.positions)
-    gx[picked] = gsel
-    model = blend.rod(c)
+    j, gx = _misfit(target, result.positions, picked, size)
+    c, v = split(blend, p)
+    model = blend.rod(c, v)
     lay = model.layout
     dj_dx = np.zeros(lay.count)
     dj_dx[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
     s = adjoint(model, result.state, dj_dx).sensitivity
     prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1)
-    return j, -blend.gradient(c, prod, s.rest_length)
+    gc, gv = blend.gradient(c, v, prod, s.rest_length)
+    return j, -np.concatenate([gc, gv])
 
 
-def _check_target(lattice: Lattice, target: SurfaceTarget) -> None:
+def _check_target(lattice: Lattice, target: SurfaceTarget | ShapeTarget) -> None:
     size = lattice.spacing * (lattice.n - 1)
     ext = getattr(target, "extent", None)
     if ext is not None:
@@ -600,9 +495,28 @@ def _check_target(lattice: Lattice, target: SurfaceTarget) -> None:
         )
 
 
+#: Speeds the calibrated speed law was measured over (mm/s): the default design range.
+MEASURED_SPEEDS = (0.25, 3.0)
+
+
+def _check_options(
+    printability: float, speed_range: tuple[float, float] | None, speed_resolution: float
+) -> None:
+    if not (np.isfinite(printability) and printability >= 0):
+        raise InvalidParameterError("printability", f"must be >= 0; got {printability}")
+    if speed_range is not None:
+        lo, hi = speed_range
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
+            raise InvalidParameterError(
+                "speed_range", f"must be 0 < low <= high mm/s; got {speed_range}"
+            )
+    if not (np.isfinite(speed_resolution) and speed_resolution > 0):
+        raise InvalidParameterError("speed_resolution", f"must be > 0 mm/s; got {speed_resolution}")
+
+
 def design_lattice(
     lattice: Lattice,
-    target: SurfaceTarget,
+    target: SurfaceTarget | ShapeTarget,
     *,
     actuation: str | Actuation | None = None,
     initial: FloatArray | None = None,
@@ -610,50 +524,81 @@ def design_lattice(
     max_iterations: int = 30,
     seed: int = 0,
     nodes: Literal["branch", "all"] = "branch",
+    speed_range: tuple[float, float] | None = MEASURED_SPEEDS,
+    speed_resolution: float = 0.05,
     callback: Callable[[int, float], None] | None = None,
 ) -> LatticeDesign:
-    """Choose per-edge expanding/contracting modes that make ``lattice`` rise into ``target``.
+    """Choose per-edge modes and print speeds that make ``lattice`` rise into ``target``.
 
     Parameters
     ----------
     lattice
-        The printed geometry (size, spacing, amplitude; its pattern is only a starting guess).
+        The printed geometry (size, spacing, amplitude; its pattern and speeds are only a
+        starting guess).
     target
-        :func:`dome`, :func:`saddle` or :func:`height_map`.
+        :func:`dome`, :func:`saddle`, :func:`height_map` or :func:`shape` (node positions of
+        the same lattice).
     actuation
-        Lattice actuation mode (default: the package's default).
+        Lattice actuation mode (only ``"program"``, the default, follows per-edge settings).
     initial
-        Starting relaxed design ``(E,)`` in [−1, 1]; default from ``lattice``'s own pattern.
+        Starting relaxed modes ``(E,)`` in [−1, 1]; default from ``lattice``'s own pattern.
     printability
-        Weight β of the term favouring printable values ±1 (dimensionless).
+        Weight β of the term favouring printable modes ±1 (dimensionless).
     max_iterations
-        L-BFGS-B iterations.
+        L-BFGS-B iterations of the first phase.
     seed
         Seed of the symmetry-breaking perturbation of the first solve.
     nodes
         Nodes compared with the target: ``"branch"`` (default: the junctions, which span the
         lattice's surface; the sinusoidal edges wiggle about it by design) or ``"all"``.
+    speed_range
+        Bounds of the per-edge print speeds (mm/s): the machine's feed limits intersected with
+        the range the speed law was measured over (default). ``None`` keeps the lattice's
+        speeds and designs the modes only.
+    speed_resolution
+        Printable speed step (mm/s): the designed speeds are rounded to multiples of it.
     callback
         ``callback(iteration, objective)`` after each optimiser iteration (progress bars).
+
+    Notes
+    -----
+    Phases: (1) L-BFGS-B on the relaxed modes and the speeds, the printability weight raised
+    tenfold twice; (2) modes rounded to ±1, the rounded optimum and the starting pattern
+    verified by a fresh ramp; (3) with the best modes fixed, L-BFGS-B on the speeds alone;
+    (4) speeds rounded to the resolution and the design verified by a fresh ramp from the
+    flat printed state, as the forward simulation runs it.
 
     Raises
     ------
     InvalidDesignError
         A target the lattice cannot reach (height map outside the lattice or too high,
         curvature that would close the lattice on itself).
+    InvalidParameterError
+        Bad options (negative printability, an empty speed range, a non-positive resolution).
     """
     _check_target(lattice, target)
-    if not (np.isfinite(printability) and printability >= 0):
-        raise InvalidParameterError("printability", f"must be >= 0; got {printability}")
+    if isinstance(target, ShapeTarget) and target.positions.shape != lattice.network.nodes.shape:
+        raise InvalidDesignError(
+            "target.positions",
+            f"must have one row per lattice node {lattice.network.nodes.shape}; got "
+            f"{target.positions.shape}",
+        )
+    _check_options(printability, speed_range, speed_resolution)
     blend = lattice_blend(lattice, actuation)
     size = lattice.spacing * (lattice.n - 1)
     eq = _Equilibria(blend, seed=seed)
+    n_edges = blend.n_edges
     if initial is None:
         c0 = np.array([1.0 if m == "expanding" else -1.0 for m in lattice.edge_mode]) * 0.9
     else:
         c0 = np.clip(np.asarray(initial, dtype=float), -1, 1)
+    v0 = lattice.speeds
+    if speed_range is None:
+        v_bounds = [(float(v), float(v)) for v in v0]
+    else:
+        v0 = np.clip(v0, *speed_range)
+        v_bounds = [(float(speed_range[0]), float(speed_range[1]))] * n_edges
     history: list[float] = []
-    n_edges = blend.n_edges
     picked = (
         np.asarray(lattice.branch_indices)
         if nodes == "branch"
@@ -661,17 +606,15 @@ def design_lattice(
     )
     weight = [printability]
 
-    def fun(c: FloatArray) -> tuple[float, FloatArray]:
+    def fun(p: FloatArray) -> tuple[float, FloatArray]:
         try:
-            res = eq(c)
-        except ConvergenceError:
-            return np.inf, np.zeros_like(c)
-        try:
-            j, grad = misfit_and_gradient(blend, c, res, target, size, picked)
-        except NotAMinimumError:
-            return np.inf, np.zeros_like(c)
+            res = eq(p)
+            j, grad = misfit_and_gradient(blend, p, res, target, size, picked)
+        except (ConvergenceError, NotAMinimumError):
+            return np.inf, np.zeros_like(p)
+        c = p[:n_edges]
         j += weight[0] * float(np.sum(1.0 - c * c))
-        grad += weight[0] * (-2.0 * c)
+        grad[:n_edges] += weight[0] * (-2.0 * c)
         history.append(j)
         return j, grad
 
@@ -682,72 +625,73 @@ def design_lattice(
         if callback is not None:
             callback(it[0], history[-1] if history else float("nan"))
 
-    # continuation in the printability weight: a free relaxed optimum first, then the weight
-    # raised tenfold twice so that the design is pushed to printable values before rounding
-    c = c0
+    def lbfgs(f: Callable[[FloatArray], tuple[float, FloatArray]], x0: FloatArray,
+              bounds: list[tuple[float, float]], maxiter: int) -> Any:  # fmt: skip
+        return minimize(
+            f, x0, jac=True, method="L-BFGS-B", bounds=bounds, callback=cb,
+            options={"maxiter": maxiter, "ftol": 1e-12, "gtol": 1e-10},
+        )  # fmt: skip
+
+    # (1) relaxed modes and speeds; the printability weight raised tenfold twice pushes the
+    # modes to printable values before rounding
+    p = np.concatenate([c0, v0])
+    bounds = [(-1.0, 1.0)] * n_edges + v_bounds
     nit = 0
-    weights = (printability, 10.0 * printability, 100.0 * printability)
-    for k, beta in enumerate(weights):
+    for k, beta in enumerate((printability, 10.0 * printability, 100.0 * printability)):
         weight[0] = beta
-        opt = minimize(
-            fun,
-            c,
-            jac=True,
-            method="L-BFGS-B",
-            bounds=[(-1.0, 1.0)] * n_edges,
-            options={
-                "maxiter": max_iterations if k == 0 else max(2, max_iterations // 3),
-                "ftol": 1e-12,
-                "gtol": 1e-10,
-            },
-            callback=cb,
-        )
-        c = opt.x
+        opt = lbfgs(fun, p, bounds, max_iterations if k == 0 else max(2, max_iterations // 3))
+        p = opt.x
         nit += int(opt.nit)
-    relaxed = np.clip(c, -1, 1)
+    relaxed = p.copy()
+    c_rel, v_rel = split(blend, relaxed)
 
     def verified(design: FloatArray) -> tuple[float, StaticResult]:
         """Misfit of a printable design after a fresh ramp, as the forward simulation runs it."""
-        res = _Equilibria(blend, seed=seed)(design)
-        stable_here = _is_minimum(blend.rod(design), res.state)
-        value = surface_misfit(res.positions[picked], target, size)[0]
+        fresh = _Equilibria(blend, seed=seed)
+        res = fresh(design)
+        eq.solves += fresh.solves
+        stable_here = _is_minimum(fresh.rod(design), res.state)
+        value = _misfit(target, res.positions, picked, size)[0]
         return (value if stable_here else np.inf), res
 
-    # rounding: the rounded optimum and the starting pattern, then single-edge flips while
-    # they lower the warm-started misfit (a discrete refinement of the printable design)
-    candidates = [np.where(relaxed >= 0, 1.0, -1.0), np.where(c0 >= 0, 1.0, -1.0)]
+    # (2) rounded modes: the rounded optimum and the starting pattern
+    candidates = [
+        np.concatenate([np.where(c_rel >= 0, 1.0, -1.0), v_rel]),
+        np.concatenate([np.where(c0 >= 0, 1.0, -1.0), v0]),
+    ]
     scored = [(verified(m), m) for m in candidates]
-    (best_j, best_res), modes = min(scored, key=lambda t: t[0][0])
-    local = _Equilibria(blend, seed=seed)
-    local.last = (modes, best_res.state)
-    for e in np.argsort(np.abs(relaxed)):  # least decided edges first
-        trial = modes.copy()
-        trial[e] = -trial[e]
-        try:
-            res = local(trial)
-        except ConvergenceError:
-            local.last = (modes, best_res.state)
-            continue
-        value = surface_misfit(res.positions[picked], target, size)[0]
-        if value < best_j and _is_minimum(blend.rod(trial), res.state):
-            modes, best_j, best_res = trial, value, res
-        else:
-            local.last = (modes, best_res.state)
-    printed = _with_pattern(
-        lattice, {e: ("expanding" if m > 0 else "contracting") for e, m in enumerate(modes)}
-    )
+    (_, best_res), best = min(scored, key=lambda t: t[0][0])
+    modes = best[:n_edges].copy()
+    speeds = best[n_edges:].copy()
+    # (3) the speeds alone with the modes fixed, warm-started from the verified state
+    if speed_range is not None:
+        eq.last = (best, best_res.state)
+        weight[0] = 0.0
+
+        def fun_v(v: FloatArray) -> tuple[float, FloatArray]:
+            j, g = fun(np.concatenate([modes, v]))
+            return j, g[n_edges:]
+
+        opt = lbfgs(fun_v, speeds, v_bounds, max(2, max_iterations // 2))
+        speeds = opt.x
+        nit += int(opt.nit)
+        # (4) printable speeds
+        lo, hi = speed_range
+        speeds = np.clip(np.round(speeds / speed_resolution) * speed_resolution, lo, hi)
+    final_p = np.concatenate([modes, speeds])
     # verification as the forward simulation does it: a fresh ramp from the flat printed state
     verify = _Equilibria(blend, seed=seed)
-    final = verify(modes)
-    j, _, _ = surface_misfit(final.positions[picked], target, size)
+    final = verify(final_p)
+    j = _misfit(target, final.positions, picked, size)[0]
     rms = float(np.sqrt(2.0 * j)) * size
-    stable = _is_minimum(blend.rod(modes), final.state)
-    branch = final.positions[lattice.branch_indices]
-    fit = fit_quadratic_surface(branch)
+    stable = _is_minimum(verify.rod(final_p), final.state)
+    fit = fit_quadratic_surface(final.positions[lattice.branch_indices])
+    printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
     return LatticeDesign(
         lattice=printed,
         relaxed=relaxed,
         modes=modes,
+        speeds=speeds,
         positions=final.positions,
         target=target,
         objective_history=np.array(history),
@@ -757,5 +701,5 @@ def design_lattice(
         target_gaussian_curvature=target.gaussian_curvature,
         stable=stable,
         iterations=nit,
-        solves=eq.solves + verify.solves + local.solves,
+        solves=eq.solves + verify.solves,
     )

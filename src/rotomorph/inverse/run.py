@@ -122,7 +122,8 @@ def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Desig
 
 
 def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
-    """The design file of a designed lattice (``pattern = "custom"`` with per-edge modes)."""
+    """The design file of a designed lattice (``pattern = "custom"`` with per-edge modes and,
+    where the design chose them, per-edge speeds)."""
     lat = design.lattice
     data = {
         "schema_version": 1,
@@ -135,6 +136,12 @@ def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
             "ghost_nodes": lat.ghost_nodes,
             "pattern": "custom",
             "edge_modes": ["expanding" if m > 0 else "contracting" for m in design.modes],
+            "speed": lat.speed,
+            **(
+                {}
+                if lat.edge_speeds is None
+                else {"edge_speeds": [round(v, 6) for v in lat.edge_speeds]}
+            ),
         },
     }
     return parse_design(data)
@@ -188,7 +195,14 @@ def run_inverse(
             progress(it, value)
 
     surf = target.surface_target()
-    des = design_lattice(lat, surf, max_iterations=opt.max_iterations, callback=cb)
+    des = design_lattice(
+        lat,
+        surf,
+        max_iterations=opt.max_iterations,
+        speed_range=(opt.min_speed, opt.max_speed),
+        speed_resolution=opt.speed_resolution,
+        callback=cb,
+    )
     k_t = des.target_gaussian_curvature
     k_a = des.achieved_gaussian_curvature
     summary = {
@@ -208,6 +222,7 @@ def run_inverse(
         "forward_solves": des.solves,
         "expanding_edges": int(np.sum(des.modes > 0)),
         "contracting_edges": int(np.sum(des.modes < 0)),
+        "speed_range_mm_s": [float(des.speeds.min()), float(des.speeds.max())],
     }
     return InverseRun(target, lattice_design_file(des, name), summary, log, des)
 

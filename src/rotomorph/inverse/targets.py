@@ -107,6 +107,7 @@ class Options(_Model):
     temperature: float = Field(175.0, ge=-50, le=300)
     min_speed: Positive = 0.25
     max_speed: Positive = 3.0
+    speed_resolution: Positive = 0.05
     max_rotation: Positive = 40.0
     max_iterations: int = Field(30, ge=1, le=500)
     radius: Positive = 0.3

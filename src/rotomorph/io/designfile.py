@@ -426,6 +426,9 @@ class LatticeModel(_Process):
     layers: int = _ranged("layers", 3, "printed layers")
     layer_height: float = _ranged("layer_height", 0.6, "layer height")
     speed: Speed = 3.0
+    edge_speeds: list[Speed] | None = Field(
+        None, description="one print speed per lattice edge, 2n(n-1) of them (mm/s)"
+    )
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
     active_material: ActiveMaterial = Field("lce", description="registered active material")
@@ -459,6 +462,10 @@ class LatticeModel(_Process):
             raise ValueError(f"pattern 'custom' needs edge_modes with one mode per edge ({m})")
         if self.pattern != "custom" and self.edge_modes is not None:
             raise ValueError("edge_modes is only used with pattern = 'custom'")
+        if self.edge_speeds is not None and len(self.edge_speeds) != m:
+            raise ValueError(
+                f"edge_speeds needs one speed per lattice edge ({m}); got {len(self.edge_speeds)}"
+            )
         return self
 
     def to_lattice(self) -> Lattice:
@@ -478,6 +485,7 @@ class LatticeModel(_Process):
             active_material=self.active_material,
             passive_material=self.passive_material,
             flip_length=self.flip_length,
+            edge_speeds=self.edge_speeds,
         )
 
 

@@ -156,13 +156,19 @@ class CurvatureScaling:
 def _janus_curvature(lm: LatticeModel, fm: FilamentModel) -> tuple[float, float]:
     """(K_J toward n (1/mm), centre-line strain ε_c) at full actuation, ω* = 0."""
     lat = lm.lattice
+    if lat.edge_speeds is not None and len(set(lat.edge_speeds)) > 1:
+        raise InvalidParameterError(
+            "actuation",
+            "'additive' and 'thermal' use one Janus curvature for the whole lattice; a lattice "
+            "with per-edge speeds needs actuation 'program'",
+        )
     sec = fm.section(
         get_material(lat.active_material),
         get_material(lat.passive_material),
         lat.radius,
         lat.active_fraction,
     )
-    e_par, e_perp, eps_p = fm.strains(np.array([lat.speed]), get_material(lat.passive_material))
+    e_par, e_perp, eps_p = fm.strains(lat.speeds[:1], get_material(lat.passive_material))
     eps_c, kappa, _ = sec.natural_strains(0.0, e_par, e_perp, eps_p)
     return float(kappa[0, 0]), float(np.asarray(eps_c).reshape(-1)[0])
 
