@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rotomorph.contact.distance import segment_distance2
+from rotomorph.contact.distance import pair_distance2, segment_distance2
 
 
 @njit(cache=True)
@@ -118,8 +118,11 @@ def pair_barrier(
     hx = np.empty((12, 12))
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
-        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], False, g, h)
+        D = pair_distance2(x, i0, i1, j0, j1)
         dist[p] = np.sqrt(D)
+        if D >= (dmin[p] + dhat) * (dmin[p] + dhat):
+            continue  # inactive: zero energy, its hloc block is left unwritten
+        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], False, g, h)
         zhat = (2.0 * dmin[p] + dhat) * dhat
         b, b1, b2 = barrier(D - dmin[p] * dmin[p], zhat)
         if b == 0.0 and b1 == 0.0:

@@ -17,20 +17,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rotomorph.contact.distance import closest_parameters
+from rotomorph.contact.distance import moving_distance2
 
 ADVANCE = 0.9  # fraction of the provably safe advance taken per sub-step
 
 
 @njit(cache=True)
 def _distance(x0, dx, t, i0, i1, j0, j1):  # pragma: no cover - compiled
-    p0 = x0[i0] + t * dx[i0]
-    p1 = x0[i1] + t * dx[i1]
-    q0 = x0[j0] + t * dx[j0]
-    q1 = x0[j1] + t * dx[j1]
-    s, u = closest_parameters(p0, p1, q0, q1)
-    r = p0 + s * (p1 - p0) - q0 - u * (q1 - q0)
-    return np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+    return np.sqrt(moving_distance2(x0, dx, t, i0, i1, j0, j1))
 
 
 @njit(cache=True)
@@ -39,37 +33,45 @@ def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragm
 
     A pair stops the advance once it has closed ``close_fraction`` of its initial gap
     (``close_fraction = 1``: only contact or ``max_substeps`` stop it). Returns 0 when a pair
-    starts at or inside contact.
+    starts at or inside contact. Pairs are advanced in the order of their first safe advance,
+    so the bound falls early and the pairs that cannot close before it are skipped.
     """
-    tmin = 1.0
-    for p in range(pairs.shape[0]):
-        idx = (pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3])
-        m = (dx[idx[0]] + dx[idx[1]] + dx[idx[2]] + dx[idx[3]]) / 4.0
+    P = pairs.shape[0]
+    gap0 = np.empty(P)
+    rate = np.empty(P)
+    first = np.empty(P)
+    for p in range(P):
+        i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
+        m = (dx[i0] + dx[i1] + dx[j0] + dx[j1]) / 4.0
         lp = 0.0
         lq = 0.0
         for n in range(4):
-            v = dx[idx[n]] - m
+            v = dx[pairs[p, n]] - m
             ln = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
             if n < 2:
                 lp = max(lp, ln)
             else:
                 lq = max(lq, ln)
-        rate = lp + lq
-        gap0 = _distance(x0, dx, 0.0, idx[0], idx[1], idx[2], idx[3]) - dmin[p]
-        if gap0 <= 0.0:
+        rate[p] = lp + lq
+        gap0[p] = _distance(x0, dx, 0.0, i0, i1, j0, j1) - dmin[p]
+        if gap0[p] <= 0.0:
             return 0.0
-        if rate * tmin <= ADVANCE * gap0:
-            continue  # cannot close within the current bound
+        first[p] = ADVANCE * gap0[p] / rate[p] if rate[p] > 0.0 else np.inf
+    tmin = 1.0
+    for p in np.argsort(first):
+        if first[p] >= tmin:
+            break  # this pair and all after it cannot close within the current bound
+        i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
         t = 0.0
-        gap = gap0
+        gap = gap0[p]
         for _ in range(max_substeps):
-            dt = ADVANCE * gap / rate
+            dt = ADVANCE * gap / rate[p]
             if t + dt >= tmin:
                 t = tmin
                 break
             t += dt
-            gap = _distance(x0, dx, t, idx[0], idx[1], idx[2], idx[3]) - dmin[p]
-            if gap <= (1.0 - close_fraction) * gap0:
+            gap = _distance(x0, dx, t, i0, i1, j0, j1) - dmin[p]
+            if gap <= (1.0 - close_fraction) * gap0[p]:
                 break
         tmin = min(tmin, t)
     return tmin

@@ -61,6 +61,52 @@ def closest_parameters(p0, p1, q0, q1):  # pragma: no cover - compiled
         C += a * r
         E += b * b
         F += b * r
+    return _closest_gram(A, B, C, E, F, R)
+
+
+@njit(cache=True)
+def pair_distance2(x, i0, i1, j0, j1):  # pragma: no cover - compiled
+    """Squared distance of segments ``x[i0] x[i1]`` and ``x[j0] x[j1]`` (no allocation)."""
+    return moving_distance2(x, x, 0.0, i0, i1, j0, j1)
+
+
+@njit(cache=True)
+def moving_distance2(x, dx, t, i0, i1, j0, j1):  # pragma: no cover - compiled
+    """Squared distance of the segments of ``x + t dx`` (no allocation)."""
+    A = 0.0
+    B = 0.0
+    C = 0.0
+    E = 0.0
+    F = 0.0
+    R = 0.0
+    for k in range(3):
+        p0 = x[i0, k] + t * dx[i0, k]
+        q0 = x[j0, k] + t * dx[j0, k]
+        a = x[i1, k] + t * dx[i1, k] - p0
+        b = x[j1, k] + t * dx[j1, k] - q0
+        r = p0 - q0
+        R += r * r
+        A += a * a
+        B += a * b
+        C += a * r
+        E += b * b
+        F += b * r
+    s, u = _closest_gram(A, B, C, E, F, R)
+    D = 0.0
+    for k in range(3):
+        p0 = x[i0, k] + t * dx[i0, k]
+        q0 = x[j0, k] + t * dx[j0, k]
+        a = x[i1, k] + t * dx[i1, k] - p0
+        b = x[j1, k] + t * dx[j1, k] - q0
+        r = p0 + s * a - q0 - u * b
+        D += r * r
+    return D
+
+
+@njit(cache=True)
+def _closest_gram(A, B, C, E, F, R):  # pragma: no cover - compiled
+    """Closest-point parameters from the Gram entries of ``a = p1 - p0``, ``b = q1 - q0``,
+    ``r = p0 - q0``: ``A = a.a, B = a.b, C = a.r, E = b.b, F = b.r, R = r.r``."""
     tiny = 1e-300
     if A <= tiny and E <= tiny:
         return 0.0, 0.0
@@ -171,9 +217,5 @@ def pair_distances(x, pairs):  # pragma: no cover - compiled
     """Centre-line distances (P,) of segment pairs ``pairs`` (P, 4) of nodes ``x`` (M, 3)."""
     out = np.empty(pairs.shape[0])
     for p in range(pairs.shape[0]):
-        p0, p1 = x[pairs[p, 0]], x[pairs[p, 1]]
-        q0, q1 = x[pairs[p, 2]], x[pairs[p, 3]]
-        s, t = closest_parameters(p0, p1, q0, q1)
-        r = p0 + s * (p1 - p0) - q0 - t * (q1 - q0)
-        out[p] = np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+        out[p] = np.sqrt(pair_distance2(x, pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]))
     return out

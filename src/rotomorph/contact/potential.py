@@ -21,10 +21,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.barrier import barrier, pair_barrier, plane_barrier
+from rotomorph.contact.broadphase import near_pairs
 from rotomorph.contact.ccd import pair_step_bound, plane_step_bound
 from rotomorph.contact.distance import closest_parameters, pair_distances
 from rotomorph.contact.exclusion import excluded_pairs
@@ -219,6 +219,9 @@ class ContactPotential:
         self._max_length = float(length.max())
         self._dmin_max = 2.0 * float(self.radius.max())
         self._lag: FrictionLag | None = None
+        # broad-phase cache: reference positions, padded margin, candidates found there
+        self._cache: tuple[FloatArray, float, _Candidates] | None = None
+        self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
         deg = np.bincount(edges.ravel(), minlength=n)
         inc = -np.ones((n, max(int(deg.max()), 1)), dtype=np.int64)
         fill = np.zeros(n, dtype=np.int64)
@@ -242,7 +245,8 @@ class ContactPotential:
         cand = self.candidates(x0)
         xe = self._extended(x0)
         nodes, weights, bases, force = [], [], [], []
-        for p in range(len(cand.quads)):
+        near = pair_distances(xe, cand.quads) < cand.dmin + self.dhat
+        for p in np.flatnonzero(near):
             i0, i1, j0, j1 = cand.quads[p]
             s, t = closest_parameters(xe[i0], xe[i1], xe[j0], xe[j1])
             w = np.array([1.0 - s, s, -(1.0 - t), -t])
@@ -283,20 +287,31 @@ class ContactPotential:
     def _extended(self, x: FloatArray) -> FloatArray:
         return np.ascontiguousarray(np.vstack([x, self._obstacle_points]), dtype=float)
 
-    def _is_excluded(self, a: IntArray, b: IntArray) -> BoolArray:
-        """Whether segment pairs ``(a, b)`` (broadcast) are graph neighbours or fused."""
-        ne = len(self.edges)
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        keys = lo * ne + hi
-        if not len(self.excluded):
-            return np.asarray(lo == hi)
-        pos = np.minimum(np.searchsorted(self.excluded, keys), len(self.excluded) - 1)
-        return np.asarray((self.excluded[pos] == keys) | (lo == hi))
-
     def candidates(self, x: FloatArray, margin: float = 0.0) -> _Candidates:
-        """Pairs and floor nodes whose distance may be below contact + activation + ``margin``."""
+        """Pairs and floor nodes whose distance may be below contact + activation + ``margin``.
+
+        The set found at one configuration with a padded margin is reused while no node has
+        moved more than half the pad since (a pair's distance changes by at most the sum of its
+        two largest node motions), so the line-search trials and the accepted iterate of a
+        Newton step share one broad phase.
+        """
+        cache = self._cache
+        if cache is not None and cache[0].shape == x.shape:
+            move = float(np.sqrt(((x - cache[0]) ** 2).sum(axis=1).max())) if len(x) else 0.0
+            if 2.0 * move + margin <= cache[1]:
+                return cache[2]
+        pad = max(float(margin), self._pad)
+        cand = self._build_candidates(x, pad)
+        self._cache = (x.copy(), pad, cand)
+        return cand
+
+    def _build_candidates(
+        self, x: FloatArray, margin: float, step: FloatArray | None = None
+    ) -> _Candidates:
+        """Candidates at ``x`` within ``margin``; with ``step``, along the straight path
+        ``x -> x + step`` (swept boxes for the network's own pairs, the step's largest node
+        motion added to ``margin`` for obstacles)."""
         edges = self.edges
-        ne = len(edges)
         quads: list[IntArray] = []
         dmins: list[FloatArray] = []
         weights: list[FloatArray] = []
@@ -308,15 +323,13 @@ class ContactPotential:
             weights.append(w)
             molls.append(m)
 
-        p0, p1 = x[edges[:, 0]], x[edges[:, 1]]
-        mid = 0.5 * (p0 + p1)
-        half = 0.5 * self._max_length
-        if self.contact.self_contact and ne > 1:
-            reach = self._dmin_max + self.dhat + 2 * half + margin
-            pairs = cKDTree(mid).query_pairs(reach, output_type="ndarray").reshape(-1, 2)
+        if self.contact.self_contact and len(edges) > 1:
+            extra = 0.5 * (self.dhat + margin)
+            pairs, ns = near_pairs(
+                x, x if step is None else x + step, edges, self._incident, self.radius + extra,
+                self.node_radius + extra, self.excluded,
+            )  # fmt: skip
             if len(pairs):
-                pairs = np.sort(pairs, axis=1)
-                pairs = pairs[~self._is_excluded(pairs[:, 0], pairs[:, 1])]
                 k, j = pairs[:, 0], pairs[:, 1]
                 L = self.length
                 add(
@@ -325,20 +338,18 @@ class ContactPotential:
                     0.5 * (L[k] + L[j]),
                     MOLLIFIER * (L[k] * L[j]) ** 2,
                 )
-                # nodes against segments: they carry side-by-side (parallel) contact
-                node = np.concatenate([edges[k, 0], edges[k, 1], edges[j, 0], edges[j, 1]])
-                seg = np.concatenate([j, j, k, k])
-                key = np.unique(node * ne + seg)
-                node, seg = key // ne, key % ne
-                inc = self._incident[node]
-                bad = ((inc >= 0) & self._is_excluded(inc, seg[:, None])).any(axis=1)
-                node, seg = node[~bad], seg[~bad]
+            if len(ns):  # nodes against segments: they carry side-by-side (parallel) contact
+                node, seg = ns[:, 0], ns[:, 1]
                 add(
                     np.stack([node, node, edges[seg, 0], edges[seg, 1]], axis=1),
                     self.node_radius[node] + self.radius[seg],
                     self.node_length[node],
                     np.zeros(len(node)),
                 )
+        if step is not None and len(step):
+            margin += float(np.sqrt((step**2).sum(axis=1).max()))
+        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
+        half = 0.5 * self._max_length
         n = self.n_nodes
         for io, o in enumerate(self._round):
             a = np.asarray(o.start if isinstance(o, Cylinder) else o.centre)
@@ -397,15 +408,22 @@ class ContactPotential:
         xe = self._extended(x)
         grad = np.zeros_like(xe)
         P = len(cand.quads)
-        # only active pairs' blocks are written (and read back, by the distance test below)
-        hloc = np.empty((P, 12, 12)) if need_hess else np.empty((0, 12, 12))
         dist = np.empty(P)
         energy = pair_barrier(
             xe, cand.quads, cand.dmin, cand.weight, cand.mollify, self.dhat, self.kappa,
-            need_grad, int(need_hess), grad, hloc, dist,
+            need_grad, 0, grad, np.empty((0, 12, 12)), dist,
         )  # fmt: skip
         if not np.isfinite(energy):
             return np.inf, None, None
+        # Hessian blocks of the active pairs only (the candidate set is padded)
+        active = np.flatnonzero(dist < cand.dmin + self.dhat)
+        quads = np.ascontiguousarray(cand.quads[active])
+        hloc = np.zeros((len(active) if need_hess else 0, 12, 12))
+        if need_hess and len(active):
+            pair_barrier(
+                xe, quads, cand.dmin[active], cand.weight[active], cand.mollify[active],
+                self.dhat, self.kappa, False, int(need_hess), grad, hloc, np.empty(len(active)),
+            )  # fmt: skip
         blocks = []
         for f, (nodes, dmin, weight) in zip(self._floors, cand.floors, strict=True):
             blk = np.zeros((len(nodes) if need_hess else 0, 3, 3))
@@ -426,12 +444,7 @@ class ContactPotential:
                 grad += gf
             extra_quads, extra_h = self._lag.nodes, hf
         g = grad[: self.n_nodes] if need_grad else None
-        active = np.flatnonzero(dist < cand.dmin + self.dhat)
-        hess = (
-            self._triplets(cand.quads[active], hloc[active], cand, fl_h, extra_quads, extra_h)
-            if need_hess
-            else None
-        )
+        hess = self._triplets(quads, hloc, cand, fl_h, extra_quads, extra_h) if need_hess else None
         return float(energy), g, hess
 
     def _triplets(
@@ -469,7 +482,7 @@ class ContactPotential:
         disp = float(np.sqrt((dx**2).sum(axis=1)).max()) if len(dx) else 0.0
         if disp == 0.0:
             return 1.0
-        cand = self.candidates(x, margin=2.0 * disp)
+        cand = self._build_candidates(x, 0.0, step=dx)
         xe = self._extended(x)
         dxe = np.zeros_like(xe)
         dxe[: self.n_nodes] = dx

@@ -24,7 +24,96 @@ from rotomorph.design.network import Network
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.sparse_cholesky import Symbolic, analyse
 
-__all__ = ["ContactTerm", "banded_to_csc"]
+__all__ = ["ContactTerm", "HessianPattern", "banded_to_csc"]
+
+#: factor growth (nonzeros of L relative to the last fresh ordering) that triggers a new one
+REORDER = 1.3
+
+
+class HessianPattern:
+    """Sparsity pattern of rod plus contact Hessians that only grows, with its analysis.
+
+    Contacts come and go between Newton iterations; re-analysing the sparse pattern each time
+    would cost more than the factorization. The pattern is the union of the rod's and every
+    contact block seen so far (explicit zeros where a contact is not active now); it is
+    re-analysed only when a new block appears. One pattern serves every solve on the same
+    network and free DOFs (the steps of a heating ramp), so a contact that recurs from one step
+    to the next costs no new analysis.
+    """
+
+    def __init__(self) -> None:
+        self.analyses = 0  # symbolic analyses (the pattern grew)
+        self.orderings = 0  # of which with a new fill-reducing ordering
+        self._ordered_nnz = 0
+        self._reset(-1)
+
+    def _reset(self, n: int) -> None:
+        self._n = n
+        self._union: tuple[np.ndarray, np.ndarray] | None = None  # CSC indices, indptr
+        self._keys: IntArray = np.zeros(0, dtype=np.int64)
+        self._base: tuple[IntArray, IntArray] | None = None  # the base's indptr, indices
+        self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
+        self._sym: Symbolic | None = None
+
+    def add(self, base: sp.csc_matrix, contact: sp.csc_matrix) -> SparseMatrix:
+        """``base + contact`` (both ``n x n``) on the grown pattern."""
+        n = base.shape[0]
+        if self._n != n:
+            self._reset(n)
+        base = base.tocsc()
+        if not base.has_sorted_indices:
+            base = base.sorted_indices()
+        known = self._base
+        if (
+            self._union is None
+            or known is None
+            or not np.array_equal(known[0], base.indptr)
+            or not np.array_equal(known[1], base.indices)
+        ):
+            self._grow(base, np.zeros(0, dtype=np.int64), n)
+        c = contact.tocoo()
+        ckeys = c.col.astype(np.int64) * n + c.row
+        keys = self._keys
+        pos = np.minimum(np.searchsorted(keys, ckeys), len(keys) - 1)
+        if not np.array_equal(keys[pos], ckeys):
+            self._grow(base, ckeys, n)
+            keys = self._keys
+            pos = np.searchsorted(keys, ckeys)
+        data = np.zeros(len(keys))
+        data[self._base_pos] = base.data
+        np.add.at(data, pos, c.data)
+        assert self._union is not None and self._sym is not None
+        indices, indptr = self._union
+        return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)
+
+    def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int) -> None:
+        bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
+        bkeys = bcol * n + base.indices
+        keys = self._keys
+        for add in (bkeys, ckeys):
+            pos = np.minimum(np.searchsorted(keys, add), max(len(keys) - 1, 0))
+            new = add if not len(keys) else add[keys[pos] != add]
+            if len(new):  # two sorted runs: a stable sort merges them in linear time
+                keys = np.sort(np.concatenate([keys, np.unique(new)]), kind="stable")
+        self._base = (base.indptr.copy(), base.indices.copy())
+        self._base_pos = np.searchsorted(keys, bkeys)
+        if self._union is not None and len(keys) == len(self._keys):
+            return  # nothing new (the base's stored entries changed, not the union)
+        rows = (keys % n).astype(np.int32)
+        counts = np.bincount(keys // n, minlength=n)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        self._union = (rows, indptr)
+        self._keys = keys
+        pattern = sp.csc_matrix((np.ones(len(keys)), rows, indptr), shape=(n, n))
+        # keep the ordering while the factor stays within REORDER of its size when ordered;
+        # a new minimum-degree ordering costs more than the numeric factorization
+        sym = None if self._sym is None else analyse(pattern, self._sym.perm)
+        if sym is None or sym.lp[-1] > REORDER * self._ordered_nnz:
+            sym = analyse(pattern)
+            self._ordered_nnz = int(sym.lp[-1])
+            self.orderings += 1
+        self._sym = sym
+        self.analyses += 1
 
 
 class ContactTerm:
@@ -42,6 +131,10 @@ class ContactTerm:
         Reduced (free) index of every layout DOF, -1 where fixed ``(ndof,)``.
     force_scale
         Typical nodal force (N) for the default barrier stiffness.
+    pattern
+        The grown sparsity pattern to start from and to update (a :class:`HessianPattern`
+        shared by the solves of one network and support set, e.g. the steps of a ramp);
+        default: a new one.
     """
 
     def __init__(
@@ -51,17 +144,13 @@ class ContactTerm:
         pos_dof: IntArray,
         reduced: IntArray,
         force_scale: float,
+        pattern: HessianPattern | None = None,
     ) -> None:
         self.potential = ContactPotential(contact, network, force_scale=force_scale)
         coord = (pos_dof[:, None] + np.arange(3)).ravel()
         self._coord_reduced = reduced[coord]  # node coordinate 3i+k -> reduced index or -1
         self._nfree = int((reduced >= 0).sum())
-        self._union: tuple[np.ndarray, np.ndarray] | None = None  # CSC indices, indptr
-        self._union_keys: IntArray = np.zeros(0, dtype=np.int64)
-        self._union_base_nnz = -1
-        self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
-        self._union_sym: Symbolic | None = None
-        self.analyses = 0  # symbolic analyses done (for benchmarks)
+        self.pattern = HessianPattern() if pattern is None else pattern
 
     # ------------------------------------------------------------------ energy
     def evaluate(
@@ -82,51 +171,14 @@ class ContactTerm:
         return e, (None if g is None else g.ravel()), hess
 
     def add_to(self, rod: BandedMatrix | SparseMatrix, contact: sp.csc_matrix) -> SparseMatrix:
-        """The rod Hessian plus the contact Hessian on a pattern that only grows.
-
-        Contacts come and go between Newton iterations; re-analysing the sparse pattern each
-        time would cost more than the factorization. The pattern is the union of the rod's and
-        every contact block seen so far in this solve (explicit zeros where a contact is not
-        active now); it is re-analysed only when a new block appears.
-        """
+        """The rod Hessian plus the contact Hessian on the grown :class:`HessianPattern`."""
         base = banded_to_csc(rod) if isinstance(rod, BandedMatrix) else rod.csc
-        n = base.shape[0]
-        c = contact.tocoo()
-        ckeys = c.col.astype(np.int64) * n + c.row
-        if self._union is None or self._union_base_nnz != base.nnz:
-            self._grow(base, ckeys, n)
-        keys, sym = self._union_keys, self._union_sym
-        assert sym is not None and self._union is not None
-        pos = np.searchsorted(keys, ckeys)
-        pos = np.minimum(pos, len(keys) - 1)
-        if not np.array_equal(keys[pos], ckeys):
-            self._grow(base, ckeys, n)
-            keys, sym = self._union_keys, self._union_sym
-            assert sym is not None
-            pos = np.searchsorted(keys, ckeys)
-        data = np.zeros(len(keys))
-        data[self._base_pos] = base.data
-        np.add.at(data, pos, c.data)
-        indices, indptr = self._union
-        return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), sym)
+        return self.pattern.add(base, contact)
 
-    def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int) -> None:
-        base = base.tocsc()
-        base.sort_indices()
-        bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
-        bkeys = bcol * n + base.indices
-        old = self._union_keys if self._union is not None else np.zeros(0, dtype=np.int64)
-        keys = np.union1d(np.union1d(old, bkeys), ckeys)
-        rows = (keys % n).astype(np.int32)
-        counts = np.bincount(keys // n, minlength=n)
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
-        self._union = (rows, indptr)
-        self._union_keys = keys
-        self._union_base_nnz = base.nnz
-        self._base_pos = np.searchsorted(keys, bkeys)
-        pattern = sp.csc_matrix((np.ones(len(keys)), rows, indptr), shape=(n, n))
-        self._union_sym = analyse(pattern)
-        self.analyses += 1
+    @property
+    def analyses(self) -> int:
+        """Symbolic analyses done on the shared pattern (for benchmarks)."""
+        return self.pattern.analyses
 
     # ------------------------------------------------------------------ steps
     def step_bound(self, pos: FloatArray, dpos: FloatArray) -> float:

@@ -25,7 +25,7 @@ from rotomorph.rod.assembly import (
 )
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
-from rotomorph.solve.contact_term import ContactTerm, tangent_rigid_modes
+from rotomorph.solve.contact_term import ContactTerm, HessianPattern, tangent_rigid_modes
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.retraction import (
@@ -143,6 +143,8 @@ class RodObjective:
                     self.force_scale / np.sqrt(n),
                     float(np.abs(self._external[self._pos_index]).max(initial=0.0)),
                 ),
+                # one grown Hessian pattern per network and support set (e.g. a whole ramp)
+                pattern=topo.setdefault("contact_pattern", HessianPattern()),
             )
             self._contact.potential.check_admissible(state.positions, "initial")
             self._contact.potential.set_lag(state.positions)  # friction lagged per solve

@@ -143,19 +143,17 @@ def _solve(n, lp, li, lx, perm, b):  # pragma: no cover - compiled
     return out
 
 
-def analyse(A: sp.csc_matrix) -> Symbolic:
-    """Ordering, elimination tree and factor pattern of the symmetric pattern of ``A``."""
+def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
+    """Ordering, elimination tree and factor pattern of the symmetric pattern of ``A``.
+
+    ``perm``: a fill-reducing ordering to keep (e.g. that of a pattern ``A`` has grown from);
+    default: a new minimum-degree ordering.
+    """
     A = sp.csc_matrix(A)
     A.sort_indices()
     n = A.shape[0]
-    # a positive definite stand-in with A's pattern, to obtain SuperLU's ordering
-    pattern = sp.csc_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
-    degree = np.asarray(abs(pattern).sum(axis=0)).ravel()
-    stand_in = (pattern + sp.diags(degree + 1.0)).tocsc()
-    lu = spla.splu(
-        stand_in, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
-    )
-    perm = np.argsort(lu.perm_c).astype(np.int64)
+    if perm is None:
+        perm = ordering(A)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
     # upper triangle of B = A[perm][:, perm], with a map back into A.data
@@ -175,6 +173,18 @@ def analyse(A: sp.csc_matrix) -> Symbolic:
     counts = _column_counts(n, bp, bi, parent)
     lp = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     return Symbolic(n=n, perm=perm, bp=bp, bi=bi, src=src, diag_src=diag_src, parent=parent, lp=lp)
+
+
+def ordering(A: sp.csc_matrix) -> IntArray:
+    """Minimum-degree ordering of the symmetric pattern of ``A`` (SuperLU's, on ``A + A^T``)."""
+    # a positive definite stand-in with A's pattern, to obtain SuperLU's ordering
+    pattern = sp.csc_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
+    degree = np.asarray(abs(pattern).sum(axis=0)).ravel()
+    stand_in = (pattern + sp.diags(degree + 1.0)).tocsc()
+    lu = spla.splu(
+        stand_in, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+    )
+    return np.argsort(lu.perm_c).astype(np.int64)
 
 
 class SparseCholesky:
