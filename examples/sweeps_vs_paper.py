@@ -5,16 +5,16 @@ Computed with rotomorph's sweep runner, next to its measurements.
 
 Three sweep files in ``examples/sweeps/`` (each also runs with ``rotomorph sweep FILE -o DIR``):
 
-* ``janus_curvature_speed.toml``: Janus curvature against print speed (Fig. 2D), run with both
-  calibrations: ``warner_terentjev`` (E_a/E_p is a *fit* to the 3 mm/s point) and
-  ``empirical_threshold`` (gain and threshold are *fits* to 0.25 and 3 mm/s); the other speeds
-  are predictions. ``curvature`` is that of the solved rod's shape, per current length (what a
-  photograph measures); the rows also give ``closed_form_curvature``, the closed-form free
-  helix's, which the rod reproduces. Both are K/stretch, while the calibration fitted the
-  natural curvature K per *printed* length to the measurement, so even the fitted points sit
-  above the measurement by the filament's axial contraction (about 18 % at 3 mm/s).
+* ``janus_curvature_speed.toml``: Janus curvature against print speed (Fig. 2D), run with two
+  materials models: ``calibrated-without-janus_curvature`` (the joint calibration without these
+  points: every point is an out-of-sample prediction, as in ``rotomorph paper``) and
+  ``calibrated`` (the default model, whose fit *includes* these points: in-sample fits, labelled
+  so). ``curvature`` is that of the solved rod's shape, per current length (what a photograph
+  measures); the rows also give ``closed_form_curvature``, the closed-form free helix's, which
+  the rod reproduces.
 * ``length_vs_rotation.toml``: L/L0 against ω* for pure LCE (Fig. 2F) and composite (Fig. 2G)
-  filaments; no parameter is fitted to these points.
+  filaments, each group predicted by the calibration that left it out
+  (``calibrated-without-pure_lce_length``, ``calibrated-without-composite_length``).
 * ``morphology_phase.toml``: the morphology (twisted rod / helix / coil) over (ω*, v), which
   the paper does not have (a prediction).
 
@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+import pyarrow.compute as pc
 
 from rotomorph.materials.measurements import load_table
 from rotomorph.plot.figure import save_figure
@@ -42,6 +43,12 @@ from rotomorph.sweep import Sweep, load_sweep, local_executor, run_sweep
 from rotomorph.sweep.figures import plot_curve, plot_heatmap, plot_phase_diagram
 
 HERE = Path(__file__).resolve().parent / "sweeps"
+
+
+def with_model(sweep: Sweep, model: str) -> Sweep:
+    """The same sweep computed with the materials model ``model`` (a settings name)."""
+    settings = sweep.settings.model_copy(update={"filament_model": model})
+    return sweep.model_copy(update={"settings": settings})
 
 
 def quick(sweep: Sweep, keep: dict[str, list[float]]) -> Sweep:
@@ -67,11 +74,15 @@ def compare(
     data: Any,
     x: str,
     output: str,
-    fitted: tuple[float, ...] = (),
+    tag: str,
+    fitted: bool = False,
     where: dict[str, Any] | None = None,
-    tag: str = "",
 ) -> list[dict[str, Any]]:
-    """Measured vs predicted rows at the measured x values present in the table."""
+    """Measured vs predicted rows at the measured x values present in the table.
+
+    ``tag`` names the materials model; ``fitted``: that model's calibration used these
+    measurements (the rows are fits, not predictions).
+    """
     rows = _rows(table, x, output, where)
     out = []
     for xi, cond, value, spread in zip(
@@ -84,13 +95,13 @@ def compare(
             {
                 "quantity": data.name,
                 "output": output,
-                "model": tag or "warner_terentjev",
+                "model": tag,
                 "condition": cond,
                 "x": float(xi),
                 "measured": float(value),
                 "spread": float(spread),
                 "predicted": None if r[output] is None else round(r[output], 4),
-                "calibration": float(xi) in fitted,
+                "calibration": fitted,
                 "physical": r["physical"],
             }
         )
@@ -127,12 +138,10 @@ def run_all(janus: Sweep, rotation: Sweep, phase: Sweep, out: Path, figs: Path, 
     rows: list[dict[str, Any]] = []
     curv = load_table("janus_curvature")
     tables = []
-    for model, fitted in (("warner_terentjev", (3.0,)), ("empirical_threshold", (0.25, 3.0))):
-        settings = janus.settings.model_copy(update={"filament_model": model})
-        sweep = janus.model_copy(update={"settings": settings})
-        t = run_sweep(sweep, out / f"janus_curvature_speed_{model}", executor=pool).table
+    for model, fitted in (("calibrated-without-janus_curvature", False), ("calibrated", True)):
+        t = run_sweep(with_model(janus, model), out / f"janus_{model}", executor=pool).table
         for output in ("curvature", "closed_form_curvature"):
-            rows += compare(t, curv, "speed", output, fitted=fitted, tag=model)
+            rows += compare(t, curv, "speed", output, tag=model, fitted=fitted)
         tables.append(t.append_column("filament_model", pa.array([model] * t.num_rows)))
     both = pa.concat_tables(tables, promote_options="default")
     fig = plot_curve(
@@ -141,21 +150,31 @@ def run_all(janus: Sweep, rotation: Sweep, phase: Sweep, out: Path, figs: Path, 
         ["curvature"],
         group="filament_model",
         measured=[(curv, "curvature")],
-        title="Janus curvature vs speed (fits: WT at 3 mm/s; threshold at 0.25 and 3 mm/s)",
+        title="Janus curvature vs speed: out of sample (fit without them) and in-sample fit",
     )
     save_figure(fig, figs / "janus_curvature_speed.png")
 
+    parts = []
+    for group, fraction in (("pure_lce_length", 1.0), ("composite_length", 0.5)):
+        model, data = f"calibrated-without-{group}", load_table(group)
+        t = run_sweep(with_model(rotation, model), out / f"length_{model}", executor=pool).table
+        rows += compare(
+            t,
+            data,
+            "omega_star",
+            "end_to_end_ratio",
+            tag=model,
+            where={"active_fraction": fraction},
+        )
+        parts.append(t.filter(pc.equal(t["active_fraction"], fraction)))
     pure, comp = load_table("pure_lce_length"), load_table("composite_length")
-    t = run_sweep(rotation, out / "length_vs_rotation", executor=pool).table
-    rows += compare(t, pure, "omega_star", "end_to_end_ratio", where={"active_fraction": 1.0})
-    rows += compare(t, comp, "omega_star", "end_to_end_ratio", where={"active_fraction": 0.5})
     fig = plot_curve(
-        t,
+        pa.concat_tables(parts),
         "omega_star",
         ["end_to_end_ratio"],
         group="active_fraction",
         measured=[(comp, "end_to_end_ratio@0.5"), (pure, "end_to_end_ratio@1.0")],
-        title="L/L0 vs ω* at 3 mm/s (predictions)",
+        title="L/L0 vs ω* at 3 mm/s (each group out of sample)",
     )
     fig.axes[0].set_xscale("log")
     save_figure(fig, figs / "length_vs_rotation.png")

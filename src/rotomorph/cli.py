@@ -469,16 +469,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
     p.add_argument("--steps", type=int, default=8, help="heating steps (default 8)")
     p.add_argument(
-        "--temperature", type=float, help="final temperature (°C, filaments; default 175)"
+        "--temperature",
+        type=float,
+        help="final temperature (°C; default 175; filaments and lattices heated by the "
+        "program or thermal actuation)",
     )
     p.add_argument(
-        "--start-temperature", type=float, help="print temperature (°C, filaments; default 25)"
+        "--start-temperature",
+        type=float,
+        help="print temperature (°C; default 25; as --temperature)",
     )
     p.add_argument("--spacing", type=float, help="filament vertex spacing override (mm)")
     p.add_argument(
         "--model",
         choices=("calibrated", "warner-terentjev", "room-temperature"),
-        help="filament materials model (filaments; default calibrated, the one 'paper' uses)",
+        help="filament materials model (default calibrated, the one 'paper' uses; filaments and "
+        "lattices heated by the program or thermal actuation)",
     )
     p.add_argument(
         "--actuation",

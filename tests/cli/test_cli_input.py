@@ -30,8 +30,17 @@ def _write(tmp_path: Path, text: str) -> Path:
 @pytest.mark.parametrize(
     ("text", "flags", "message"),
     [
-        (LATTICE.format(n=3), ["--temperature", "150"], "--temperature: applies to filaments"),
-        (LATTICE.format(n=3), ["--start-temperature", "20"], "--start-temperature: applies"),
+        (
+            LATTICE.format(n=3),
+            ["--actuation", "swapped", "--temperature", "150"],
+            "--temperature: does not apply to the 'swapped' actuation",
+        ),
+        (
+            LATTICE.format(n=3),
+            ["--actuation", "radius", "--start-temperature", "20"],
+            "--start-temperature: does not apply to the 'radius' actuation",
+        ),
+        (LATTICE.format(n=3), ["--temperature", "1e12"], r"--temperature: must lie in [-50"),
         (LATTICE.format(n=3), ["--spacing", "0.5"], "--spacing: applies to filaments"),
         (FILAMENT, ["--actuation", "thermal"], "--actuation: applies to lattices only"),
         (FILAMENT, ["--temperature", "1e12"], r"--temperature: must lie in [-50, 300] °C"),

@@ -24,12 +24,17 @@ def test_sweeps_example_quick(tmp_path, capsys):
     }
     # no shape passes through itself (stability is reported as unknown where not checked)
     assert all(r["predicted"] is not None and r["physical"] is not False for r in rows)
+    # in-sample fits are labelled: the calibrated model saw the Janus curvatures; every other
+    # row comes from a calibration that left its group out
     fits = {(r["model"], r["x"]) for r in rows if r["calibration"]}
-    assert fits == {
-        ("warner_terentjev", 3.0),
-        ("empirical_threshold", 0.25),
-        ("empirical_threshold", 3.0),
+    assert fits == {("calibrated", x) for x in (0.25, 1.75, 3.0)}
+    assert {r["model"] for r in rows if not r["calibration"]} == {
+        "calibrated-without-janus_curvature",
+        "calibrated-without-pure_lce_length",
+        "calibrated-without-composite_length",
     }
+    for r in rows:
+        assert r["model"] == "calibrated" or r["model"].endswith(r["quantity"])
     # the rod reproduces the closed-form helix's curvature
     by = {(r["model"], r["output"], r["x"]): r["predicted"] for r in rows}
     for (model, output, x), value in by.items():

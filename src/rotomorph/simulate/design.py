@@ -288,8 +288,37 @@ def lattice_assumptions(lattice: Any) -> dict[str, Any]:
     }
 
 
+def _lattice_actuation(
+    rule: str,
+    start_temperature: float | None,
+    temperature: float | None,
+    model: FilamentModel | None,
+) -> Any:
+    """The actuation object of a lattice run: a temperature ramp for the temperature-driven
+    rules (default 25 → 175 °C, the calibrated model), the rule's name otherwise."""
+    from rotomorph.lattice.actuation import ProgramActuation, ThermalActuation
+
+    if rule not in ("program", "thermal"):
+        return rule
+    start = PRINT_TEMPERATURE if start_temperature is None else float(start_temperature)
+    end = ACTUATION_TEMPERATURE if temperature is None else float(temperature)
+    if not start < end:
+        raise InvalidParameterError(
+            "temperature", f"must exceed the start temperature {start:g} °C; got {end:g} °C"
+        )
+    cls = ProgramActuation if rule == "program" else ThermalActuation
+    return cls(start=start, end=end, filament_model=model)
+
+
 def _simulate_lattice(
-    design: Any, *, steps: int, actuation: str, progress: Progress | None
+    design: Any,
+    *,
+    steps: int,
+    actuation: str,
+    progress: Progress | None,
+    start_temperature: float | None = None,
+    temperature: float | None = None,
+    model: FilamentModel | None = None,
 ) -> DesignSimulation:
     from rotomorph.lattice.heating import heat_lattice  # lattice-only
 
@@ -305,7 +334,8 @@ def _simulate_lattice(
     )
     lattice = lat.to_lattice()
     phase_log.info("set-up: rod model, sparsity pattern; then solving %d heating step(s)", steps)
-    res = heat_lattice(lattice, actuation=actuation, steps=steps)
+    rule = _lattice_actuation(actuation, start_temperature, temperature, model)
+    res = heat_lattice(lattice, actuation=rule, steps=steps)
     if progress is not None:
         progress(1)
     phase_log.info("analysis: curvature changes, areas")
@@ -377,11 +407,13 @@ def simulate_design(
     steps
         Heating steps; results hold ``steps + 1`` states.
     start_temperature, temperature
-        Ramp of the filaments (°C; default 25 → 175 °C, range
-        :data:`rotomorph.simulate.options.TEMPERATURE_RANGE`). Refused for lattices, which
-        use their own actuation parameter.
+        Temperature ramp (°C; default 25 → 175 °C, range
+        :data:`rotomorph.simulate.options.TEMPERATURE_RANGE`) of filaments and of lattices
+        heated by a temperature-driven actuation (``program``, ``thermal``); refused with the
+        paper's x-readings, which ramp x from 0 to 0.75.
     model
-        Filament modelling choices (default calibrated :class:`FilamentModel`); filaments only.
+        Filament modelling choices (default calibrated :class:`FilamentModel`); filaments and
+        temperature-driven lattices.
     spacing
         Override the filaments' vertex spacing (mm; the design is re-validated); coarser is
         faster. Filaments only.
@@ -418,7 +450,13 @@ def simulate_design(
     )
     if design.lattice is not None:
         sim = _simulate_lattice(
-            design, steps=steps, actuation=actuation or DEFAULT_ACTUATION, progress=progress
+            design,
+            steps=steps,
+            actuation=actuation or DEFAULT_ACTUATION,
+            progress=progress,
+            start_temperature=start_temperature,
+            temperature=temperature,
+            model=model,
         )
     else:
         if spacing is not None:

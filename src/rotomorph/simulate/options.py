@@ -1,8 +1,10 @@
 """Checks of the run options of :func:`rotomorph.simulate.design.simulate_design`.
 
-An option that does not apply to a design is refused, never ignored: temperatures, a vertex
-spacing and a filament model apply to filaments (heated over a temperature ramp); an actuation
-rule applies to lattices (ramped by that rule). Values outside a physical range are refused with
+An option that does not apply to a design is refused, never ignored: a vertex spacing applies
+to filaments; an actuation rule to lattices; temperatures and a filament model to filaments and
+to lattices heated by a temperature-driven rule (``program``, the default, and ``thermal``),
+not to the paper's x-readings (``literal``, ``swapped``, ``radius``, ``additive``), which ramp
+x from 0 to 0.75. Values outside a physical range are refused with
 the range (:data:`TEMPERATURE_RANGE`, :data:`MAX_STEPS`). The CLI (``rotomorph simulate``) and
 the Python API run the same checks.
 """
@@ -14,10 +16,12 @@ from typing import Any, Final
 
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["MAX_STEPS", "TEMPERATURE_RANGE", "check_run_options"]
+__all__ = ["MAX_STEPS", "TEMPERATURE_ACTUATIONS", "TEMPERATURE_RANGE", "check_run_options"]
 
 #: Accepted temperatures (°C): the materials' data cover printing to well above actuation.
 TEMPERATURE_RANGE: Final = (-50.0, 300.0)
+#: Lattice actuation rules ramped in temperature (the others ramp the paper's x).
+TEMPERATURE_ACTUATIONS: Final = ("program", "thermal")
 #: Most heating steps of one run.
 MAX_STEPS: Final = 10_000
 
@@ -59,20 +63,27 @@ def check_run_options(
             "steps", f"must be a whole number in [1, {MAX_STEPS}]; got {steps!r}"
         )
     if kind == "lattice":
-        for name, value in (
-            ("temperature", temperature),
-            ("start_temperature", start_temperature),
-            ("spacing", spacing),
-            ("model", model),
-        ):
-            if value is not None:
-                raise InvalidParameterError(
-                    name,
-                    "applies to filaments only; a lattice is ramped by its actuation rule "
-                    "(actuation); remove it",
-                )
-        return
-    if actuation is not None:
+        if spacing is not None:
+            raise InvalidParameterError(
+                "spacing",
+                "applies to filaments only; a lattice's vertex spacing is its "
+                "ghost_nodes field; remove it",
+            )
+        rule = "program" if actuation is None else actuation
+        if rule not in TEMPERATURE_ACTUATIONS:
+            for name, value in (
+                ("temperature", temperature),
+                ("start_temperature", start_temperature),
+                ("model", model),
+            ):
+                if value is not None:
+                    raise InvalidParameterError(
+                        name,
+                        f"does not apply to the {rule!r} actuation, which ramps the paper's x "
+                        "from 0 to 0.75; remove it, or use a temperature-driven actuation "
+                        "(program, thermal)",
+                    )
+    elif actuation is not None:
         raise InvalidParameterError(
             "actuation",
             "applies to lattices only; filaments are heated over a temperature ramp "

@@ -174,16 +174,30 @@ def _number(x: Any) -> float | None:
 
 
 @functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)
 def filament_model(name: str) -> Any:
-    """The :class:`~rotomorph.materials.natural.FilamentModel` a sweep's settings name."""
-    from rotomorph.materials.natural import FilamentModel
+    """The :class:`~rotomorph.materials.natural.FilamentModel` a sweep's settings name.
 
-    if name == "warner_terentjev":
-        return FilamentModel()
-    if name == "empirical_threshold":
+    ``calibrated`` and the physical priors come from
+    :func:`rotomorph.materials.natural.named_model`; ``calibrated-without-<group>`` is the
+    joint calibration leaving that measured group out
+    (:func:`rotomorph.materials.calibrate.paper_calibration`, about 1.5 s, once per process),
+    evaluated on the section mesh of the calibrated model.
+    """
+    from rotomorph.materials.calibrate import CALIBRATION_GROUPS
+    from rotomorph.materials.natural import MODEL_NAMES, named_model
+
+    if name in MODEL_NAMES:
+        return named_model(name)
+    prefix = "calibrated-without-"
+    group = name.removeprefix(prefix)
+    if name.startswith(prefix) and group in CALIBRATION_GROUPS:
+        import dataclasses
+
         from rotomorph.materials.calibrate import paper_calibration
 
-        return paper_calibration().chosen.model
+        model = paper_calibration(exclude=(group,)).chosen.model
+        return dataclasses.replace(model, resolution=named_model("calibrated").resolution)
     raise InvalidParameterError("settings.filament_model", f"unknown model {name!r}")
 
 

@@ -182,16 +182,19 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
         physical = {"verdict": "unknown", "reason": "closed form: no equilibrium was solved"}
         return {"filaments": shapes, "physical": physical}, None
     from rotomorph.simulate.design import simulate_design
+    from rotomorph.simulate.options import TEMPERATURE_ACTUATIONS
 
-    # simulate_design refuses options that do not apply: a lattice takes the actuation rule,
+    # simulate_design refuses options that do not apply: a lattice takes the actuation rule
+    # (and, when that rule is driven by temperature, the ramp and the filament model),
     # filaments the temperatures, spacing and filament model
     lattice = design.lattice is not None
+    ramped = not lattice or s["actuation"] in TEMPERATURE_ACTUATIONS
     sim = simulate_design(
         design,
         steps=s["steps"],
-        start_temperature=None if lattice else s["start_temperature"],
-        temperature=None if lattice else s["temperature"],
-        model=None if lattice else model,
+        start_temperature=s["start_temperature"] if ramped else None,
+        temperature=s["temperature"] if ramped else None,
+        model=model if ramped else None,
         spacing=None if lattice else s["spacing"],
         actuation=s["actuation"] if lattice else None,
     )

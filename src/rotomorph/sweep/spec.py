@@ -193,10 +193,14 @@ class Settings(_Model):
     (:func:`rotomorph.simulate.design.simulate_design`); ``"closed_form"`` evaluates the
     closed-form free helix of each filament's natural field at ``temperature`` (uniform
     filaments only, no lattices; milliseconds per run).
-    ``filament_model`` picks the calibration: ``"warner_terentjev"`` (E_a/E_p fitted to the
-    Janus curvature at 3 mm/s) or ``"empirical_threshold"`` (threshold strain law and E_a/E_p
-    fitted jointly to the paper's filament data; see
-    :func:`rotomorph.materials.calibrate.paper_calibration`).
+    ``filament_model`` names the materials model: ``"calibrated"``
+    (default; the joint fit to the paper's Janus curvatures and pure-LCE and composite L/L0,
+    the model of ``rotomorph simulate`` and ``rotomorph paper``), ``"calibrated-without-<group>"``
+    (the same fit leaving that group out, so the group's points are out-of-sample predictions,
+    as in the report), ``"warner-terentjev"`` and ``"room-temperature"`` (physical priors; see
+    :func:`rotomorph.materials.natural.named_model`). ``actuation`` is the lattice actuation
+    rule (default ``"program"``, as ``rotomorph simulate``); temperatures and the filament model
+    apply to lattices only with the temperature-driven rules ``program`` and ``thermal``.
     """
 
     method: Literal["rod", "closed_form"] = "rod"
@@ -204,8 +208,15 @@ class Settings(_Model):
     start_temperature: float = Field(25.0, description="°C")
     temperature: float = Field(175.0, description="°C")
     spacing: float | None = Field(None, gt=0, description="vertex spacing override (mm)")
-    actuation: Literal["literal", "swapped", "radius", "additive", "thermal"] = "swapped"
-    filament_model: Literal["warner_terentjev", "empirical_threshold"] = "warner_terentjev"
+    actuation: Literal["program", "thermal", "literal", "swapped", "radius", "additive"] = "program"
+    filament_model: Literal[
+        "calibrated",
+        "calibrated-without-janus_curvature",
+        "calibrated-without-pure_lce_length",
+        "calibrated-without-composite_length",
+        "warner-terentjev",
+        "room-temperature",
+    ] = "calibrated"
 
     @model_validator(mode="after")
     def _ramp(self) -> Settings:
