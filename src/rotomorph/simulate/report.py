@@ -45,6 +45,11 @@ from rotomorph.materials import FilamentModel, load_table
 from rotomorph.materials.calibrate import filament_shapes, janus_curvature
 from rotomorph.materials.inference import Fit
 from rotomorph.simulate.cache import disk_cached
+from rotomorph.simulate.report_shapes import (
+    filament_shapes_figure,
+    free_shape_normals,
+    lattice_tube_figure,
+)
 from rotomorph.simulate.validation import (
     FILAMENT_SPACINGS,
     SINUSOID_DESIGN,
@@ -175,7 +180,8 @@ def _rotation_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
         rows += sel
         for w in ROTATION_NUMBERS:
             prog = _straight(fraction, w, FILAMENT_SPACINGS[0])
-            shapes[(label, w)] = (prog.points, free_shape(prog, model))
+            x = free_shape(prog, model)
+            shapes[(label, w)] = (prog, x, free_shape_normals(prog, model, x))
         curve = [s.end_to_end_ratio for s in filament_shapes(model, dense, fraction)]
         ax.plot(dense, curve, "k-", lw=1, label="free helix, fit to all groups")
         ax.errorbar(
@@ -202,24 +208,9 @@ def _rotation_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 
 
 def _shapes_figure(shapes: dict[tuple[str, float], Any], path: Path) -> Path:
-    from rotomorph.plot.figure import new_figure, save_figure
+    from rotomorph.plot.figure import save_figure
 
-    fig = new_figure(12.0, 6.0)
-    labels = sorted({k[0] for k in shapes}, reverse=True)
-    for r, label in enumerate(labels):
-        for c, w in enumerate(ROTATION_NUMBERS):
-            ax = fig.add_subplot(len(labels), len(ROTATION_NUMBERS), r * 4 + c + 1, projection="3d")
-            printed, x = shapes[(label, w)]
-            ratio = np.linalg.norm(x[-1] - x[0]) / np.linalg.norm(printed[-1] - printed[0])
-            x = x - x.mean(axis=0)
-            ax.plot(x[:, 0], x[:, 1], x[:, 2], lw=1.2,
-                    color="tab:red" if label == "composite" else "0.3")  # fmt: skip
-            span = float(np.ptp(x, axis=0).max()) / 2 or 1.0
-            for setter in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
-                setter(-span, span)
-            ax.set_title(f"{label} ω*={w:g}, 30 mm\nend-to-end {ratio:.2f}", fontsize=8)
-            ax.tick_params(labelsize=5)
-    return save_figure(fig, path)
+    return save_figure(filament_shapes_figure(shapes), path)
 
 
 def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Path]]:
@@ -322,7 +313,6 @@ def _lattice_section(
     model = at_resolution(fit.model)
     from rotomorph.analysis.curvature import network_relative_curvature_change
     from rotomorph.plot.figure import new_figure, save_figure
-    from rotomorph.plot.shapes import plot_lattice_views
 
     rows: list[dict] = []
     paths: list[Path] = []
@@ -429,12 +419,8 @@ def _lattice_section(
             if res.contact is not None
             else f"no contact needed: clearance {np.min(res.min_clearance):.2f} diameters"
         )
-        f = plot_lattice_views(
-            res.positions[k],
-            lattice.network.edges,
-            rel,
-            label="(κ − κ_i)/κ_i",
-            title=f"{pattern}, ramp {res.parameter[k]:.3g} ({state})",
+        f = lattice_tube_figure(
+            lattice, res, rel, title=f"{pattern} lattice, {res.parameter[k]:.3g} °C ({state})"
         )
         paths.append(save_figure(f, figs / f"lattice_{pattern}_views.png"))
     # Fig. 4C/F: sign and characteristic curvature vs strain
