@@ -365,8 +365,8 @@ def plot_tube_panels(
     panel_height
         Height of a panel (inches; default ``panel_size``): less for flat or long shapes.
     zoom
-        Size of the 3-D box in its panel (matplotlib's ``set_box_aspect`` zoom); above 1 for
-        long or flat boxes, whose projection leaves most of a panel empty.
+        Size of the 3-D box in its panel (matplotlib's ``set_box_aspect`` zoom; what reaches
+        beyond the panel is cut off).
     elev, azim
         Camera angles (degrees), the same in every panel.
     cmap, norm, label

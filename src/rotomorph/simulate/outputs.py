@@ -50,6 +50,9 @@ __all__ = [
 #: Tube radius (mm) when a results file does not store one.
 DEFAULT_RADIUS = 0.3
 _RED = "#b2182b"
+#: Height over width of a filament panel: a filament's box is long and flat, a square panel
+#: would be mostly empty.
+FILAMENT_PANEL_HEIGHT = 0.6
 
 
 def colour_field(results: RunResults) -> tuple[str | None, str]:
@@ -199,7 +202,11 @@ def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
         return plot_tube_panels(panels, suptitle=title, suptitle_colour=colour, columns=3)
     panels = _filament_panels(results, last)
     return plot_tube_panels(
-        panels, suptitle=title, suptitle_colour=colour, columns=min(len(panels), 4)
+        panels,
+        suptitle=title,
+        suptitle_colour=colour,
+        columns=min(len(panels), 4),
+        panel_height=FILAMENT_PANEL_HEIGHT * 3.6,
     )
 
 
@@ -266,6 +273,7 @@ def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
         panels,
         columns=len(steps),
         panel_size=3.0,
+        panel_height=FILAMENT_PANEL_HEIGHT * 3.0,
         suptitle=f"Heating ramp{note}",
         suptitle_colour=_RED if v.verdict == "no" else "k",
     )
