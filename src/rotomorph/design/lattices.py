@@ -398,7 +398,8 @@ def sinusoidal_lattice(
     spacing
         Node spacing l (mm), > 0. Not given in the paper; default 5 mm.
     amplitude
-        Sine amplitude A (mm), >= 0 (0 gives straight edges); default 1.25 mm (A/l = 0.25, Q5).
+        Sine amplitude A (mm), >= 0 (0 gives straight edges); default 1.25 mm (A/l = 0.25;
+        not given in the paper).
     ghost_nodes
         Ghost nodes per edge n_g (>= 1); paper: 10 (425 nodes in all for n = 5).
     pattern

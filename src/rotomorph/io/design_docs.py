@@ -28,6 +28,7 @@ _SECTIONS: Final = (
     ('`[[filaments.segments]]` with `kind = "sinusoid"`', "SinusoidSegment"),
     ('`[[filaments.segments]]` with `kind = "polyline"`', "PolylineSegment"),
     ("`[lattice]`", "LatticeModel"),
+    ("`[contact]`", "ContactModel"),
 )
 
 

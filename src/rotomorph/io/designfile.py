@@ -84,6 +84,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SCHEMA_VERSION",
+    "ContactModel",
     "Design",
     "design_schema",
     "design_size",
@@ -505,6 +506,45 @@ class Nozzle(_Model):
     )
 
 
+class ContactModel(_Model):
+    """How the heated structure touches itself and its surroundings.
+
+    Absent from a design: no contact model (a state whose filaments pass through each other is
+    computed, then flagged as not physical). Present: filaments touch instead of passing through
+    each other (:mod:`rotomorph.contact`), optionally resting on the bath floor under their
+    buoyant weight.
+    """
+
+    self_contact: bool = Field(
+        True, description="filaments touch instead of passing through each other"
+    )
+    floor: bool = Field(
+        False, description="a rigid floor (the bath bottom) just below the printed structure"
+    )
+    gravity: bool = Field(
+        False, description="buoyant self-weight in the bath; needs floor = true (free structures)"
+    )
+    bath: Literal["silicone_oil"] = Field(
+        "silicone_oil", description="bath fluid of the buoyancy (materials bath table)"
+    )
+    friction: float = Field(
+        0.0, ge=0, le=10, description="Coulomb friction coefficient of every contact"
+    )
+
+    @model_validator(mode="after")
+    def _weight_needs_support(self) -> ContactModel:
+        if self.gravity and not self.floor:
+            raise ValueError(
+                "gravity = true needs floor = true: a free structure under its weight must rest "
+                "on the bath floor"
+            )
+        if not (self.self_contact or self.floor):
+            raise ValueError(
+                "nothing to touch: set self_contact = true or floor = true, or remove [contact]"
+            )
+        return self
+
+
 class Design(_Model):
     """A validated design file (filaments and/or a lattice)."""
 
@@ -516,6 +556,9 @@ class Design(_Model):
         default_factory=list, max_length=10_000, description="filaments (or a lattice, not both)"
     )
     lattice: LatticeModel | None = Field(None, description="one sinusoidal lattice")
+    contact: ContactModel | None = Field(
+        None, description="contact, floor and buoyant weight when heated (absent: none)"
+    )
 
     @field_validator("schema_version", mode="before")
     @classmethod

@@ -540,7 +540,7 @@ def free_edge_ratio(
     """End-to-end ratio L/L0 of one lattice edge printed alone and actuated freely.
 
     The single sinusoid of paper Fig. 3C/D (1.37 ± 0.07 expanding, 0.64 ± 0.05 contracting);
-    for a homogeneous lattice the area ratio is this ratio squared (notes C1, 2.7).
+    for a homogeneous lattice of independent edges the area ratio is about this ratio squared.
 
     Parameters
     ----------

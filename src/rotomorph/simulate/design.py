@@ -35,6 +35,11 @@ from rotomorph.simulate.filament import (
     simulate_filament,
 )
 from rotomorph.simulate.options import check_run_options
+from rotomorph.simulate.surroundings import (
+    filament_surroundings,
+    lattice_surroundings,
+    surroundings_record,
+)
 
 __all__ = ["DesignSimulation", "filaments_simulation", "simulate_design", "step_count"]
 
@@ -174,6 +179,7 @@ def _simulate_filaments(
             steps,
         )
         program = fil.to_program()
+        contact, loads = filament_surroundings(design.contact, program, fil, temperature)
         sims.append(
             simulate_filament(
                 program,
@@ -183,11 +189,17 @@ def _simulate_filaments(
                 temperature=temperature,
                 model=model,
                 progress=progress,
+                contact=contact,
+                loads=loads,
             )
         )
-    return filaments_simulation(
+    sim = filaments_simulation(
         sims, design.model_dump(mode="json"), temperatures=(start_temperature, temperature)
     )
+    record = surroundings_record(design.contact, temperature)
+    if record is None:
+        return sim
+    return replace(sim, metadata={**sim.metadata, "contact": record})
 
 
 def filaments_simulation(
@@ -335,7 +347,13 @@ def _simulate_lattice(
     lattice = lat.to_lattice()
     phase_log.info("set-up: rod model, sparsity pattern; then solving %d heating step(s)", steps)
     rule = _lattice_actuation(actuation, start_temperature, temperature, model)
-    res = heat_lattice(lattice, actuation=rule, steps=steps)
+    hot = float(getattr(rule, "end", ACTUATION_TEMPERATURE))  # x-readings: the paper's 175 °C
+    res = heat_lattice(
+        lattice,
+        actuation=rule,
+        steps=steps,
+        **lattice_surroundings(design.contact, lattice, hot),
+    )
     if progress is not None:
         progress(1)
     phase_log.info("analysis: curvature changes, areas")
@@ -365,6 +383,7 @@ def _simulate_lattice(
         "edge_mode": list(lattice.edge_mode),
         "final": {k: float(v[-1]) for k, v in scalars.items()},
         "actuation_rule": res.actuation,
+        "contact": surroundings_record(design.contact, hot),
         "assumptions": lattice_assumptions(lattice),
         "lattice_wall_time_s": float(np.sum(res.wall_time)),
     }

@@ -44,6 +44,7 @@ from rotomorph.materials.process import actuation_fraction
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
 from rotomorph.solve.continuation import continuation
+from rotomorph.solve.loads import Loads
 from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.static import StaticResult, solve_static
 
@@ -262,6 +263,7 @@ def simulate_filament(
     max_refinements: int = 4,
     progress: Progress | None = None,
     contact: Contact | None = None,
+    loads: Loads | None = None,
 ) -> FilamentSimulation:
     """Equilibrium shapes of a free filament heated from ``start_temperature`` to ``temperature``.
 
@@ -286,6 +288,9 @@ def simulate_filament(
     contact
         Self-contact (and obstacles) of the filament (:class:`rotomorph.contact.Contact`):
         tight coils touch instead of passing through themselves.
+    loads
+        Dead loads (:class:`rotomorph.solve.loads.Loads`), e.g. the buoyant weight of a
+        filament resting on a floor obstacle.
 
     Raises
     ------
@@ -323,7 +328,11 @@ def simulate_filament(
         k = min(int(np.floor(w)), s - 2)
         field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
         res = solve_static(
-            rod_model(program, field), initial=initial, options=options, contact=contact
+            rod_model(program, field),
+            loads=loads,
+            initial=initial,
+            options=options,
+            contact=contact,
         )
         iterations_at[w] = iterations_at.get(w, 0) + res.iterations
         if progress is not None and w == int(w):

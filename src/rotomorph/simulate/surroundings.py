@@ -1,0 +1,116 @@
+"""What a design's ``[contact]`` table turns into for a run: contact settings, the bath floor
+and the buoyant weight, plus the record of those choices for the run's outputs.
+
+The floor lies just below the printed structure (centre lines ``1.005 r`` above it, as a
+filament printed on the substrate rests); the buoyant line weight is
+(ρ_filament − ρ_bath) g A with ρ_filament the inks' densities weighted by the section's active
+share, and ρ_bath the bath fluid's density at the run's final temperature
+(:func:`rotomorph.materials.bath.bath_density`, data and source in the bath-fluid table).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from rotomorph.contact import Contact, Floor
+from rotomorph.materials.bath import bath_density, bath_fluids
+from rotomorph.materials.material import get_material
+from rotomorph.solve.loads import Gravity, Loads
+
+__all__ = ["FLOOR_GAP", "filament_surroundings", "lattice_surroundings", "surroundings_record"]
+
+#: Height of the centre line above the floor, in filament radii, of a structure resting on it.
+FLOOR_GAP = 1.005
+
+
+def _density(active: str, passive: str, active_fraction: float) -> float:
+    """Section density (g/cm³): the inks' densities by area share (1.1 where none is given)."""
+    rho_a = get_material(active).density or 1.1
+    rho_p = get_material(passive).density or 1.1
+    return float(active_fraction * rho_a + (1.0 - active_fraction) * rho_p)
+
+
+def _floor_below(points: Any, radius: float) -> Floor:
+    return Floor(height=float(np.asarray(points)[:, 2].min()) - FLOOR_GAP * float(radius))
+
+
+def filament_surroundings(
+    contact: Any, program: Any, filament: Any, temperature: float
+) -> tuple[Contact | None, Loads | None]:
+    """Contact settings and loads of one filament (``None, None`` without ``[contact]``).
+
+    Parameters
+    ----------
+    contact
+        The design's ``contact`` table (:class:`rotomorph.io.designfile.ContactModel`) or None.
+    program
+        The filament's print program (vertices, radius).
+    filament
+        The filament's design entry (materials, active fraction).
+    temperature
+        Final temperature of the run (°C): the bath density is taken there.
+    """
+    if contact is None:
+        return None, None
+    radius = float(program.radius)
+    obstacles = (_floor_below(program.points, radius),) if contact.floor else ()
+    settings = Contact(
+        radius=radius,
+        obstacles=obstacles,
+        self_contact=contact.self_contact,
+        friction=contact.friction,
+    )
+    loads = None
+    if contact.gravity:
+        density = _density(
+            filament.active_material, filament.passive_material, filament.active_fraction
+        )
+        gravity = Gravity(
+            density=density,
+            area=np.pi * radius**2,
+            fluid_density=bath_density(contact.bath, temperature),
+        )
+        loads = Loads(gravity=gravity)
+    return settings, loads
+
+
+def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict[str, Any]:
+    """Keyword arguments of :func:`rotomorph.lattice.heating.heat_lattice` for ``[contact]``
+    (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``."""
+    if contact is None:
+        return {}
+    from rotomorph.lattice.heating import lattice_gravity  # lattice-only
+
+    kwargs: dict[str, Any] = {
+        "contact": Contact(radius=lattice.radius, self_contact=contact.self_contact),
+        "floor": bool(contact.floor),
+        "friction": float(contact.friction),
+    }
+    if contact.gravity:
+        kwargs["gravity"] = lattice_gravity(
+            lattice, fluid_density=bath_density(contact.bath, temperature)
+        )
+    return kwargs
+
+
+def surroundings_record(contact: Any, temperature: float) -> dict[str, Any] | None:
+    """What the run assumed about its surroundings, for ``summary.json`` and the HDF5 file."""
+    if contact is None:
+        return None
+    record: dict[str, Any] = {
+        "self_contact": bool(contact.self_contact),
+        "floor": bool(contact.floor),
+        "gravity": bool(contact.gravity),
+        "friction": float(contact.friction),
+    }
+    if contact.gravity:
+        fluid = bath_fluids()[contact.bath]
+        record.update(
+            bath=contact.bath,
+            bath_density_g_cm3=round(bath_density(contact.bath, temperature), 4),
+            bath_density_source=str(fluid.get("source", "")),
+            bath_density_assumption=str(fluid.get("assumptions", "")),
+        )
+    return record

@@ -1,0 +1,77 @@
+"""A design's [contact] table: validated like every field, and it makes a self-crossing run
+physical (filaments touch instead of passing through; the floor carries the buoyant weight)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotomorph.errors import InvalidDesignError
+from rotomorph.io.designfile import parse_design
+from rotomorph.simulate.design import simulate_design
+from rotomorph.simulate.run_data import describe_run
+from rotomorph.simulate.surroundings import FLOOR_GAP
+
+# a Janus filament curls to about 0.6 /mm when heated: 13 mm turn through more than a circle
+RING = {
+    "schema_version": 1,
+    "filaments": [
+        {
+            "speed": 3.0,
+            "rotation": 0.0,
+            "spacing": 0.3,
+            "segments": [{"kind": "line", "length": 13.0}],
+        }
+    ],
+}
+
+
+def _run(contact=None):
+    data = dict(RING) if contact is None else {**RING, "contact": contact}
+    sim = simulate_design(parse_design(data), steps=3)
+    return sim, describe_run(sim)
+
+
+def test_without_contact_the_ring_passes_through_itself_and_is_flagged():
+    _, run = _run()
+    assert run.metadata["physical"]["verdict"] == "no"
+    assert "contact not modelled" in run.metadata["physical"]["reason"]
+
+
+def test_self_contact_keeps_the_ring_apart():
+    _, run = _run({"self_contact": True})
+    assert run.metadata["physical"]["verdict"] == "yes", run.metadata["physical"]
+    assert np.min(run.scalars["min_clearance"]) >= 0.999
+    assert run.metadata["contact"] == {
+        "self_contact": True,
+        "floor": False,
+        "gravity": False,
+        "friction": 0.0,
+    }
+
+
+def test_on_the_floor_under_buoyant_weight():
+    sim, run = _run({"floor": True, "gravity": True})
+    r = 0.3
+    floor = -FLOOR_GAP * r  # printed at z = 0
+    lowest = sim.positions[:, :, 2].min()
+    assert lowest >= floor + r * (1 - 1e-3)  # never through the floor
+    assert sim.positions[-1, :, 2].max() < floor + 4 * r  # weighed down: stays near the floor
+    record = run.metadata["contact"]
+    assert record["gravity"] and 0.8 < record["bath_density_g_cm3"] < 0.97  # hot oil, lighter
+    assert "PDMS" in record["bath_density_assumption"] or record["bath_density_source"]
+
+
+@pytest.mark.parametrize(
+    ("contact", "message"),
+    [
+        ({"gravity": True}, "gravity = true needs floor = true"),
+        ({"self_contact": False}, "nothing to touch"),
+        ({"friction": -0.1}, "contact.friction"),
+        ({"floor": "yes"}, "contact.floor"),
+        ({"wall": True}, "contact.wall"),
+    ],
+)
+def test_bad_contact_tables_are_refused(contact, message):
+    with pytest.raises(InvalidDesignError, match=message.replace(".", r"\.")):
+        parse_design({**RING, "contact": contact})
