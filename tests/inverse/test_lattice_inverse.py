@@ -64,7 +64,7 @@ def test_adjoint_gradient_matches_central_differences(small):
             assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
 
 
-def test_design_is_printable_verified_and_written_as_a_design_file():
+def test_design_is_printable_verified_and_written_as_a_design_file(tmp_path):
     start = sinusoidal_lattice(
         n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
     )
@@ -82,6 +82,14 @@ def test_design_is_printable_verified_and_written_as_a_design_file():
     # the written design is the verified one, speeds included
     assert file.lattice.to_lattice().edge_mode == des.lattice.edge_mode
     assert np.allclose(file.lattice.to_lattice().speeds, des.speeds)
+    # validate, simulate and gcode accept it unchanged
+    from rotomorph.cli import main
+    from rotomorph.io.designfile import save_design
+
+    path = save_design(file, tmp_path / "dome.toml")
+    assert main(["validate", str(path)]) == 0
+    assert main(["gcode", str(path), "-o", str(tmp_path / "dome.gcode")]) == 0
+    assert main(["simulate", str(path), "-o", str(tmp_path / "run"), "--steps", "4"]) == 0
 
 
 def test_bad_lattice_targets_have_clear_errors(small):

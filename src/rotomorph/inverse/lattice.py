@@ -514,6 +514,91 @@ def _check_options(
         raise InvalidParameterError("speed_resolution", f"must be > 0 mm/s; got {speed_resolution}")
 
 
+def _speed_steps(speed_range: tuple[float, float], resolution: float) -> tuple[int, int]:
+    """First and last multiple of ``resolution`` inside ``speed_range`` (in steps)."""
+    lo = int(np.ceil(speed_range[0] / resolution - 1e-9))
+    hi = int(np.floor(speed_range[1] / resolution + 1e-9))
+    return lo, hi
+
+
+def _printable_speeds(
+    speeds: FloatArray, speed_range: tuple[float, float], resolution: float
+) -> FloatArray:
+    """``speeds`` rounded to the nearest multiple of ``resolution`` inside ``speed_range``."""
+    lo, hi = _speed_steps(speed_range, resolution)
+    return np.clip(np.round(np.asarray(speeds) / resolution), lo, hi) * resolution
+
+
+def _same_strength(
+    blend: LatticeBlend, c: FloatArray, v: FloatArray, speed_range: tuple[float, float]
+) -> FloatArray:
+    """Speeds ``(E,)`` (mm/s) at which a printable edge (mode ±1) bends as strongly as the
+    relaxed edge ``(c, v)``.
+
+    Without director rotation a Janus section bends in proportion to the mismatch
+    ``ε_p − ε∥(v)`` of its two halves along the filament, and inside an edge the blend is
+    ``c`` times the printable actuation; the speed whose mismatch is ``|c|`` times that at
+    ``v`` keeps the edge's bending (clipped to the range; unchanged where the mismatch is not
+    monotonic in the speed over the range).
+    """
+    grid = np.geomspace(speed_range[0], speed_range[1], 2001)
+    passive = blend.chain.passive_strain
+
+    def mismatch(speed: FloatArray) -> FloatArray:
+        return np.abs(passive - blend.chain.strains(speed)[:, 0])
+
+    strength = mismatch(grid)
+    if not np.all(np.diff(strength) > 0):
+        return np.asarray(v, dtype=float)
+    wanted = np.abs(c) * mismatch(np.asarray(v, dtype=float))
+    return np.interp(wanted, strength, grid)
+
+
+#: Factors of the overall bending strength tried about the optimised speeds (phase 5).
+STRENGTH_SCALES = (0.84, 0.92, 1.08, 1.18)
+
+
+@dataclass(frozen=True, eq=False)
+class _Check:
+    """A printable design verified by a fresh ramp."""
+
+    result: StaticResult
+    misfit: float
+    stable: bool
+    fit: Any
+    solves: int
+    target_k: float | None
+
+    @property
+    def rank(self) -> tuple[bool, float]:
+        """Unstable last; then by the Gaussian-curvature error (the misfit without a K)."""
+        if self.target_k is None:
+            return (not self.stable, self.misfit)
+        err = abs(abs(self.fit.gaussian_curvature) - abs(self.target_k)) / abs(self.target_k)
+        return (not self.stable, err)
+
+
+def _verify(
+    blend: LatticeBlend,
+    p: FloatArray,
+    seed: int,
+    target: SurfaceTarget | ShapeTarget,
+    picked: IntArray,
+    size: float,
+    lattice: Lattice,
+) -> _Check:
+    fresh = _Equilibria(blend, seed=seed)
+    res = fresh(p)
+    return _Check(
+        result=res,
+        misfit=_misfit(target, res.positions, picked, size)[0],
+        stable=_is_minimum(fresh.rod(p), res.state),
+        fit=fit_quadratic_surface(res.positions[lattice.branch_indices]),
+        solves=fresh.solves,
+        target_k=target.gaussian_curvature,
+    )
+
+
 def design_lattice(
     lattice: Lattice,
     target: SurfaceTarget | ShapeTarget,
@@ -556,17 +641,24 @@ def design_lattice(
         the range the speed law was measured over (default). ``None`` keeps the lattice's
         speeds and designs the modes only.
     speed_resolution
-        Printable speed step (mm/s): the designed speeds are rounded to multiples of it.
+        Printable speed step (mm/s): the designed speeds are rounded to the multiples of it
+        that lie in ``speed_range``.
     callback
         ``callback(iteration, objective)`` after each optimiser iteration (progress bars).
 
     Notes
     -----
     Phases: (1) L-BFGS-B on the relaxed modes and the speeds, the printability weight raised
-    tenfold twice; (2) modes rounded to ±1, the rounded optimum and the starting pattern
-    verified by a fresh ramp; (3) with the best modes fixed, L-BFGS-B on the speeds alone;
-    (4) speeds rounded to the resolution and the design verified by a fresh ramp from the
-    flat printed state, as the forward simulation runs it.
+    tenfold twice; (2) modes rounded to ±1 (an edge's relaxed strength kept by lowering its
+    speed), the rounded optimum and the starting pattern verified by a fresh ramp; (3) with
+    the best modes fixed, L-BFGS-B on the speeds alone; (4) speeds rounded to the resolution
+    and the design verified by a fresh ramp from the flat printed state, as the forward
+    simulation runs it; (5) for targets with a Gaussian curvature K (dome, saddle), the
+    overall bending strength is also scaled by each of :data:`STRENGTH_SCALES`, then by steps
+    of 4 % and 2 % about the best scale (every edge's speed moved so that its mismatch changes
+    by that factor, rounded again); each candidate is verified the same way, and the stable
+    one whose K is closest to the target's is kept: the height misfit is nearly flat along this
+    direction at its optimum while K is not.
 
     Raises
     ------
@@ -645,22 +737,21 @@ def design_lattice(
     relaxed = p.copy()
     c_rel, v_rel = split(blend, relaxed)
 
-    def verified(design: FloatArray) -> tuple[float, StaticResult]:
-        """Misfit of a printable design after a fresh ramp, as the forward simulation runs it."""
-        fresh = _Equilibria(blend, seed=seed)
-        res = fresh(design)
-        eq.solves += fresh.solves
-        stable_here = _is_minimum(fresh.rod(design), res.state)
-        value = _misfit(target, res.positions, picked, size)[0]
-        return (value if stable_here else np.inf), res
-
-    # (2) rounded modes: the rounded optimum and the starting pattern
+    # (2) rounded modes: the rounded optimum (its strength kept by the speed where speeds are
+    # free, else as is) and the starting pattern
+    signs = np.where(c_rel >= 0, 1.0, -1.0)
     candidates = [
-        np.concatenate([np.where(c_rel >= 0, 1.0, -1.0), v_rel]),
+        np.concatenate([signs, v_rel]),
         np.concatenate([np.where(c0 >= 0, 1.0, -1.0), v0]),
     ]
-    scored = [(verified(m), m) for m in candidates]
-    (_, best_res), best = min(scored, key=lambda t: t[0][0])
+    if speed_range is not None:
+        candidates.insert(
+            0, np.concatenate([signs, _same_strength(blend, c_rel, v_rel, speed_range)])
+        )
+    scored = [(_verify(blend, m, seed, target, picked, size, lattice), m) for m in candidates]
+    eq.solves += sum(check.solves for check, _ in scored)
+    best_check, best = min(scored, key=lambda t: t[0].misfit if t[0].stable else np.inf)
+    best_res = best_check.result
     modes = best[:n_edges].copy()
     speeds = best[n_edges:].copy()
     # (3) the speeds alone with the modes fixed, warm-started from the verified state
@@ -672,20 +763,39 @@ def design_lattice(
             j, g = fun(np.concatenate([modes, v]))
             return j, g[n_edges:]
 
-        opt = lbfgs(fun_v, speeds, v_bounds, max(2, max_iterations // 2))
+        opt = lbfgs(fun_v, speeds, v_bounds, max_iterations)
         speeds = opt.x
         nit += int(opt.nit)
         # (4) printable speeds
-        lo, hi = speed_range
-        speeds = np.clip(np.round(speeds / speed_resolution) * speed_resolution, lo, hi)
-    final_p = np.concatenate([modes, speeds])
+        speeds = _printable_speeds(speeds, speed_range, speed_resolution)
     # verification as the forward simulation does it: a fresh ramp from the flat printed state
-    verify = _Equilibria(blend, seed=seed)
-    final = verify(final_p)
-    j = _misfit(target, final.positions, picked, size)[0]
+    base = speeds
+
+    def check_scale(scale: float) -> tuple[FloatArray, _Check]:
+        v = base
+        if scale != 1.0:
+            v = _same_strength(blend, scale * modes, base, speed_range or MEASURED_SPEEDS)
+            v = _printable_speeds(v, speed_range or MEASURED_SPEEDS, speed_resolution)
+        checked = _verify(blend, np.concatenate([modes, v]), seed, target, picked, size, lattice)
+        eq.solves += checked.solves
+        return v, checked
+
+    tried = {1.0: check_scale(1.0)}
+    if speed_range is not None and target.gaussian_curvature is not None:
+        # (5) the overall bending strength scaled about the optimum (every edge's mismatch
+        # times s): the misfit is flat in this direction near its optimum, the target's K is
+        # not. A coarse grid, then two rounds of halved steps about the best scale.
+        for scale in STRENGTH_SCALES:
+            tried[scale] = check_scale(scale)
+        step = 0.04
+        for _ in range(2):
+            best_s = min(tried, key=lambda k: tried[k][1].rank)
+            for scale in (best_s * (1 - step), best_s * (1 + step)):
+                tried.setdefault(scale, check_scale(scale))
+            step /= 2
+    speeds, check = min(tried.values(), key=lambda t: t[1].rank)
+    final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
     rms = float(np.sqrt(2.0 * j)) * size
-    stable = _is_minimum(verify.rod(final_p), final.state)
-    fit = fit_quadratic_surface(final.positions[lattice.branch_indices])
     printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
     return LatticeDesign(
         lattice=printed,
@@ -701,5 +811,5 @@ def design_lattice(
         target_gaussian_curvature=target.gaussian_curvature,
         stable=stable,
         iterations=nit,
-        solves=eq.solves + verify.solves,
+        solves=eq.solves,
     )

@@ -137,6 +137,8 @@ def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
             "pattern": "custom",
             "edge_modes": ["expanding" if m > 0 else "contracting" for m in design.modes],
             "speed": lat.speed,
+            # printed away from the machine's origin, as the example lattices are
+            "origin": [20.0, 20.0, 0.0],
             **(
                 {}
                 if lat.edge_speeds is None
