@@ -29,8 +29,10 @@ def test_every_law_states_its_status_and_source():
 
 
 def test_moduli_run_from_the_measured_cold_ratio_to_the_calibrated_hot_one():
-    model = FilamentModel(temperature_dependent=True)
-    assert FilamentModel().moduli(LCE, ACR, 25.0) == FilamentModel().moduli(LCE, ACR)
+    model = FilamentModel()  # the temperature laws are the default
+    assert model.temperature_dependent
+    flat = FilamentModel(temperature_dependent=False)
+    assert flat.moduli(LCE, ACR, 25.0) == flat.moduli(LCE, ACR) == model.moduli(LCE, ACR)
     cold = model.moduli(LCE, ACR, 25.0)
     hot = model.moduli(LCE, ACR, 175.0)
     assert cold[1] == pytest.approx(0.57)

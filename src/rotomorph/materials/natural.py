@@ -118,12 +118,13 @@ class FilamentModel:
     resolution
         Boundary vertices of the section mesh.
     temperature_dependent
-        ``True``: moduli and passive strain follow the temperature laws of
-        :mod:`rotomorph.materials.temperature` over a heating ramp. ``False`` (default, what
-        the calibration and the paper report use): the full-actuation moduli at every
-        temperature and every eigenstrain scaled by x(T). Both give the same state at the
-        actuation temperature to 1e-3; they differ on the way (e.g. where a contracting
-        lattice first touches itself).
+        ``True`` (default): over a heating ramp the moduli and the passive strain follow the
+        temperature laws of :mod:`rotomorph.materials.temperature` (what is measured and what
+        is assumed is listed there) and the LCE eigenstrains scale with x(T). ``False``: the
+        full-actuation moduli at every temperature and every eigenstrain scaled by x(T). The
+        calibration works at full actuation, where both agree (free shapes at 175 °C to
+        1e-4); they differ on the way (e.g. where a contracting lattice first touches
+        itself).
     """
 
     strain_model: ActuationStrainModel = field(default_factory=_calibrated_strain_model)
@@ -133,7 +134,7 @@ class FilamentModel:
     hysteresis: float = 0.0
     direction: Literal["heating", "cooling"] = "heating"
     resolution: int = DEFAULT_RESOLUTION
-    temperature_dependent: bool = False
+    temperature_dependent: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.strain_model, ActuationStrainModel):
