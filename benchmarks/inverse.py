@@ -29,6 +29,7 @@ import numpy as np
 
 from rotomorph.analysis.curvature import discrete_curvature
 from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.inverse.adjoint import richardson_difference
 from rotomorph.inverse.filament import design_filament
 from rotomorph.inverse.lattice import (
     _Equilibria,
@@ -68,7 +69,8 @@ def filament_case(name: str, spec: CurveSpec, table) -> None:  # type: ignore[no
 
 def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
     """Worst relative error of the adjoint gradient against Richardson-extrapolated central
-    differences, on three mode and three speed variables (perturbed solves to rtol 1e-13)."""
+    differences (:func:`rotomorph.inverse.adjoint.richardson_difference`, base step 1e-3),
+    on three mode and three speed variables (perturbed solves to rtol 1e-13)."""
     blend = lattice_blend(lattice)
     eq = _Equilibria(blend)
     c = np.array([0.8 if m == "expanding" else -0.8 for m in lattice.edge_mode])
@@ -79,18 +81,15 @@ def _fd_check(lattice, target) -> float:  # type: ignore[no-untyped-def]
     eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
     worst = 0.0
 
-    def central(e: int, h: float) -> float:
-        vals = []
-        for sgn in (1, -1):
-            pp = p.copy()
-            pp[e] += sgn * h
-            eq.last = (p, res.state)
-            vals.append(surface_misfit(eq(pp).positions, target, size)[0])
-        return (vals[0] - vals[1]) / (2 * h)
+    def shifted(e: int, h: float) -> float:
+        pp = p.copy()
+        pp[e] += h
+        eq.last = (p, res.state)
+        return surface_misfit(eq(pp).positions, target, size)[0]
 
     n = blend.n_edges
     for e in (0, 13, 27, n + 0, n + 13, n + 27):
-        fd = (4 * central(e, 5e-4) - central(e, 1e-3)) / 3  # Richardson, O(h^4)
+        fd = richardson_difference(lambda h, e=e: shifted(e, h), 1e-3)
         worst = max(worst, abs(g[e] - fd) / max(abs(fd), 1e-300))
     return worst
 

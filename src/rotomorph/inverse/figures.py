@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from rotomorph.inverse.filament import FilamentDesign
-from rotomorph.inverse.lattice import LatticeDesign, SurfaceTarget, surface_misfit
+from rotomorph.inverse.lattice import LatticeDesign, SurfaceTarget, rigid_motion, surface_misfit
 from rotomorph.plot.figure import new_figure, save_figure
 
 __all__ = ["inverse_figures"]
@@ -97,11 +97,8 @@ def _on_surface(design: LatticeDesign, target: SurfaceTarget, folder: Path) -> P
     lat = design.lattice
     size = lat.spacing * (lat.n - 1)
     _, _, p = surface_misfit(design.positions, target, size)
-    from scipy.spatial.transform import Rotation
-
     x = design.positions
-    y = Rotation.from_rotvec(p[:3]).apply(x - x.mean(axis=0))
-    y[:, 2] += p[3]
+    y = rigid_motion(p, x - x.mean(axis=0))
     z_t, _, _ = target.height(y[:, 0], y[:, 1])
     err = y[:, 2] - z_t
     fig = new_figure(13, 5, dpi=150)

@@ -69,6 +69,7 @@ __all__ = [
     "height_map",
     "lattice_blend",
     "misfit_and_gradient",
+    "rigid_motion",
     "saddle",
     "shape",
     "shape_misfit",
@@ -198,8 +199,13 @@ def shape(positions: FloatArray) -> ShapeTarget:
 
 
 # ---------------------------------------------------------------------------------- misfit
-def _rigid(params: FloatArray, x: FloatArray) -> FloatArray:
-    y = Rotation.from_rotvec(params[:3]).apply(x)
+def rigid_motion(params: FloatArray, x: FloatArray) -> FloatArray:
+    """``x`` ``(N, 3)`` (mm) turned by ``Rz(γ) · R(a, b, 0)`` and raised by ``dz``, with
+    ``params = (a, b, γ, dz)``: a swing about a horizontal axis (rotation vector ``(a, b, 0)``,
+    rad) then a twist about z (rad). Every rotation is such a product, and the twist stays a
+    well-scaled coordinate however far it turns (a rotation vector does not)."""
+    rot = Rotation.from_euler("z", params[2]) * Rotation.from_rotvec([params[0], params[1], 0.0])
+    y = rot.apply(x)
     y[:, 2] += params[3]
     return y
 
@@ -208,46 +214,55 @@ def surface_misfit(
     positions: FloatArray, target: SurfaceTarget, size: float
 ) -> tuple[float, FloatArray, FloatArray]:
     """Aligned misfit ``J``, its gradient ``(N, 3)`` w.r.t. ``positions`` (1/mm) and the
-    alignment (rotation vector, vertical offset).
+    alignment ``(a, b, γ, dz)`` of :func:`rigid_motion` (applied to the centred nodes).
 
     The nodes are centred (their centroid goes to x = y = 0, where the target is centred),
     then rotated and moved vertically to minimise
-    ``J = (sum_i r_i² + |reg·rotvec|²) / (2 N)`` with ``r_i = (z'_i − f(x'_i, y'_i)) / size``;
-    the alignment starts from the centred state and from its upside-down copy. A tiny penalty
-    on the rotation vector keeps the alignment unique when the target has a continuous
-    symmetry (a dome turns freely about z). The gradient is exact at the optimal alignment
-    (envelope theorem), including the centroid's dependence on every node.
+    ``J = sum_i r_i² / (2 N)`` with ``r_i = (z'_i − f(x'_i, y'_i)) / size``; the alignment
+    starts from the centred state and from its upside-down copy. J is exactly invariant under
+    rigid motions of ``positions`` (no term anchors the alignment to the lab frame; for a
+    target symmetric about z, such as an isotropic dome, the twist γ is left out), which the
+    adjoint of a free lattice needs: its equilibrium is defined up to a rigid motion. The
+    gradient is exact at the optimal alignment (envelope theorem), including the centroid's
+    dependence on every node.
     """
     x = np.asarray(positions, dtype=float)
     n = len(x)
     xc = x - x.mean(axis=0)
-    reg = 1e-3
 
-    def residuals(p: FloatArray, p0: FloatArray) -> FloatArray:
-        y = _rigid(p, xc)
+    def residuals(p: FloatArray) -> FloatArray:
+        y = rigid_motion(p, xc)
         z, _, _ = target.height(y[:, 0], y[:, 1])
-        return np.concatenate([(y[:, 2] - z) / size, reg * (p[:3] - p0[:3])])
+        return (y[:, 2] - z) / size
 
-    best: tuple[Any, FloatArray] | None = None
+    best: Any = None
     for flip in (0.0, np.pi):
         p0 = np.array([flip, 0.0, 0.0, 0.0])
-        y0 = _rigid(p0, xc)
+        y0 = rigid_motion(p0, xc)
         z0, _, _ = target.height(y0[:, 0], y0[:, 1])
         p0[3] = float(np.mean(z0 - y0[:, 2]))
-        sol = least_squares(
-            residuals, p0, args=(p0,), xtol=1e-15, ftol=1e-15, gtol=1e-15, method="lm"
-        )
-        if best is None or sol.cost < best[0].cost:
-            best = (sol, p0)
-    assert best is not None
-    sol, p0 = best
-    p = sol.x
-    y = _rigid(p, xc)
+        r0 = residuals(p0)
+        # a target symmetric about z (an isotropic dome): the twist is no coordinate at all
+        turned = residuals(p0 + np.array([0.0, 0.0, 0.3, 0.0]))
+        free = [0, 1, 3] if np.allclose(turned, r0, rtol=0, atol=1e-13) else [0, 1, 2, 3]
+
+        def sub(q: FloatArray, p0: FloatArray = p0, free: list[int] = free) -> FloatArray:
+            full = p0.copy()
+            full[free] = q
+            return residuals(full)
+
+        sol = least_squares(sub, p0[free], xtol=1e-15, ftol=1e-15, gtol=1e-15, method="lm")
+        full = p0.copy()
+        full[free] = sol.x
+        if best is None or sol.cost < best[0]:
+            best = (sol.cost, full)
+    p = best[1]
+    y = rigid_motion(p, xc)
     z, zx, zy = target.height(y[:, 0], y[:, 1])
     r = (y[:, 2] - z) / size
-    j = 0.5 * (float(r @ r) + float(np.sum((reg * (p[:3] - p0[:3])) ** 2))) / n
+    j = 0.5 * float(r @ r) / n
     dr_dy = np.stack([-zx, -zy, np.ones(n)], axis=1) / size
-    rot = Rotation.from_rotvec(p[:3]).as_matrix()
+    rot = (Rotation.from_euler("z", p[2]) * Rotation.from_rotvec([p[0], p[1], 0.0])).as_matrix()
     per_node = (r[:, None] * dr_dy) @ rot / n
     grad = per_node - per_node.mean(axis=0)
     return j, grad, p
