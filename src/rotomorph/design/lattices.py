@@ -231,18 +231,19 @@ class Lattice:
             list(range(nx + i * m, nx + (i + 1) * m)) for i in range(self.n)
         ]
 
-    def _edge_points(self, e: int, subdivide: int) -> FloatArray:
-        """Points of lattice edge ``e`` at ghost parameter s = 0, 1/k, ..., n_g+1 (mm)."""
-        a, b = self.edge_nodes[e]
-        start = self.network.nodes[a]
-        t = (self.network.nodes[b] - start) / self.spacing
+    def _edge_points(self, edges: IntArray, subdivide: int) -> FloatArray:
+        """Points ``(len(edges), k, 3)`` of lattice edges at ghost parameter s = 0, 1/k, ...,
+        n_g+1 (mm), k = (n_g+1)·subdivide + 1."""
+        ends = self.edge_nodes[edges]
+        start = self.network.nodes[ends[:, 0]]
+        t = (self.network.nodes[ends[:, 1]] - start) / self.spacing
         nrm = np.cross([0.0, 0.0, 1.0], t)
         per = self.ghost_nodes + 1
         s = np.arange(per * subdivide + 1) / subdivide
         return (
-            start
-            + np.outer(s * self.spacing / per, t)
-            + np.outer(self.amplitude * np.sin(2 * np.pi * s / per), nrm)
+            start[:, None, :]
+            + (s * self.spacing / per)[None, :, None] * t[:, None, :]
+            + (self.amplitude * np.sin(2 * np.pi * s / per))[None, :, None] * nrm[:, None, :]
         )
 
     @property
@@ -273,8 +274,7 @@ class Lattice:
         per = self.ghost_nodes + 1
         out = []
         for prog, line in zip(progs, self._lines(), strict=True):
-            segs = np.concatenate([np.arange(e * per, (e + 1) * per) for e in line])
-            out.append((prog, segs))
+            out.append((prog, (np.asarray(line)[:, None] * per + np.arange(per)).ravel()))
         return out
 
     def print_programs(self, subdivide: int = 4) -> list[PrintProgram]:
@@ -304,17 +304,15 @@ class Lattice:
         if key not in self._cache:
             base = []
             edge_speed = self.speeds
+            expanding = np.array([m == "expanding" for m in self.edge_mode])
             for line in self._lines():
-                pieces = [self._edge_points(line[0], subdivide)[:1]]
-                side = [1.0 if self.edge_mode[line[0]] == "expanding" else -1.0]
-                for e in line:
-                    pts = self._edge_points(e, subdivide)[1:]
-                    pieces.append(pts)
-                    sgn = 1.0 if self.edge_mode[e] == "expanding" else -1.0
-                    side.extend([sgn] * len(pts))
+                pts = self._edge_points(np.asarray(line), subdivide)
+                sgn = np.where(expanding[line], 1.0, -1.0)
+                pieces = [pts[0, :1], pts[:, 1:].reshape(-1, 3)]
+                side = np.concatenate([sgn[:1], np.repeat(sgn, pts.shape[1] - 1)])
                 speed = edge_speed[self._vertex_edges(line, subdivide)]
                 path = Path(np.concatenate(pieces))
-                alpha = active_side_angle(path, np.array(side), self.flip_length)
+                alpha = active_side_angle(path, side, self.flip_length)
                 base.append(
                     PrintProgram.from_interface_angle(
                         path,
@@ -451,24 +449,23 @@ def sinusoidal_lattice(
     branch_xyz = np.column_stack([spacing * ii, spacing * jj, np.zeros(n * n)])
     s = np.arange(1, ghost_nodes + 1, dtype=float)
     per = ghost_nodes + 1
-    ghosts, chains, segs = [], [], []
-    z = np.array([0.0, 0.0, 1.0])
-    for e, (a, b) in enumerate(edges):
-        t = (branch_xyz[b] - branch_xyz[a]) / spacing
-        nrm = np.cross(z, t)  # N = z x T on every edge
-        ghosts.append(
-            branch_xyz[a]
-            + np.outer(s * spacing / per, t)
-            + np.outer(amplitude * np.sin(2 * np.pi * s / per), nrm)
-        )
-        chain = np.concatenate([[a], n * n + e * ghost_nodes + np.arange(ghost_nodes), [b]])
-        chain.setflags(write=False)
-        chains.append(chain)
-        segs.append(np.column_stack([chain[:-1], chain[1:]]))
-    nodes = np.concatenate([branch_xyz, *ghosts])
+    # every edge at once (the same operations per element as one edge at a time)
+    t = (branch_xyz[edges[:, 1]] - branch_xyz[edges[:, 0]]) / spacing
+    nrm = np.cross(np.array([0.0, 0.0, 1.0]), t)  # N = z x T on every edge
+    ghosts = (
+        branch_xyz[edges[:, 0]][:, None, :]
+        + (s * spacing / per)[None, :, None] * t[:, None, :]
+        + (amplitude * np.sin(2 * np.pi * s / per))[None, :, None] * nrm[:, None, :]
+    ).reshape(-1, 3)
+    inner = n * n + np.arange(len(edges))[:, None] * ghost_nodes + np.arange(ghost_nodes)
+    chain_table = np.column_stack([edges[:, 0], inner, edges[:, 1]])
+    chain_table.setflags(write=False)
+    chains = list(chain_table)
+    segments = np.column_stack([chain_table[:, :-1].ravel(), chain_table[:, 1:].ravel()])
+    nodes = np.concatenate([branch_xyz, ghosts])
     branch = np.zeros(len(nodes), dtype=bool)
     branch[: n * n] = True
-    network = Network(nodes, np.concatenate(segs), branch)
+    network = Network(nodes, segments, branch)
     edges.setflags(write=False)
     return Lattice(
         network,

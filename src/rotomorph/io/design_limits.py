@@ -34,8 +34,10 @@ __all__ = [
 MAX_NODES: Final = 500_000
 #: Memory of a lattice solve per rod node (bytes; Hessian, factor, states), measured.
 BYTES_PER_NODE: Final = 20_000  # 19.8 kB/node at 18 300 nodes (30 x 30 lattice)
-#: Set-up time (model, sparsity pattern, ordering) per rod node (s), measured on 2 cores.
-SETUP_S_PER_NODE: Final = 1.5e-4
+#: Set-up time (model, natural field, sparsity pattern, ordering) per rod node (s) on 2 cores:
+#: 40 µs/node CPU measured for a 100 x 100 lattice (benchmarks/lattice_setup.py), with margin
+#: for a busy machine.
+SETUP_S_PER_NODE: Final = 6e-5
 
 
 @dataclass(frozen=True)

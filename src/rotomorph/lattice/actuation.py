@@ -271,33 +271,29 @@ def _line_stencils(lm: LatticeModel) -> list[tuple[int, IntArray, IntArray, IntA
     cache = lm.lattice._cache
     if key not in cache:
         st = lm.model.stencils
-        segments = np.arange(lm.model.network.n_edges) if lm.segments is None else lm.segments
-        model_edge = {int(g): k for k, g in enumerate(segments)}
-        index = {
-            (int(min(a, b)), int(max(a, b))): k
-            for k, (a, b) in enumerate(zip(st.edge_e, st.edge_f, strict=True))
-        }
+        n_model = lm.model.network.n_edges
+        segments = np.arange(n_model) if lm.segments is None else np.asarray(lm.segments)
+        # network segment -> model edge (-1: not in the model)
+        model_edge = -np.ones(lm.lattice.network.n_edges, dtype=np.int64)
+        model_edge[segments] = np.arange(len(segments))
+        # stencil of an unordered pair of model edges, looked up by a sorted integer key
+        pair = np.sort(np.column_stack([st.edge_e, st.edge_f]).astype(np.int64), axis=1)
+        pair_key = pair[:, 0] * n_model + pair[:, 1]
+        order = np.argsort(pair_key, kind="stable")
+        sorted_key = pair_key[order]
         out = []
         for line, (_, segs) in enumerate(lm.lattice.line_programs()):
-            edges = [model_edge.get(int(g)) for g in segs]
-            rows, stencils = [], []
-            for i in range(1, len(segs)):
-                a, b = edges[i - 1], edges[i]
-                k = None if a is None or b is None else index.get((min(a, b), max(a, b)))
-                if k is not None:
-                    rows.append(i - 1)
-                    stencils.append(k)
-            here = [i for i, e in enumerate(edges) if e is not None]
-            if here:
-                out.append(
-                    (
-                        line,
-                        np.array(rows, dtype=np.int64),
-                        np.array(stencils, dtype=np.int64),
-                        np.array(here, dtype=np.int64),
-                        np.array([edges[i] for i in here], dtype=np.int64),
-                    )
-                )
+            edges = model_edge[segs]
+            a, b = edges[:-1], edges[1:]
+            both = (a >= 0) & (b >= 0)
+            query = np.minimum(a, b) * n_model + np.maximum(a, b)
+            pos = np.searchsorted(sorted_key, query)
+            found = both & (pos < len(sorted_key))
+            found[found] = sorted_key[pos[found]] == query[found]
+            here = np.flatnonzero(edges >= 0)
+            if len(here):
+                rows = np.flatnonzero(found)
+                out.append((line, rows, order[pos[rows]], here, edges[here]))
         cache[key] = out
     return cache[key]  # type: ignore[no-any-return]
 

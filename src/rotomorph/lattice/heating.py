@@ -19,6 +19,7 @@ printed (fused at junctions). Contact is not modelled: values < 1 mean filaments
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -69,6 +70,9 @@ RAMP_OPTIONS = NewtonOptions(rtol=1e-7, max_iterations=300, eigenvalues=1)
 
 SupportsName = Literal["free", "clamped-boundary", "pinned-centre"]
 
+#: Phase messages of long lattice runs (a command line shows them; silent by default).
+phase_log = logging.getLogger("rotomorph.progress")
+
 
 def perturbed_state(model: Model, dz: FloatArray) -> State:
     """The printed state with node heights raised by ``dz`` ``(N,)`` (mm).
@@ -94,7 +98,14 @@ def perturbed_state(model: Model, dz: FloatArray) -> State:
     d1 = unit(parallel_transport(ref.directors, ref.tangents, t))
     st = model.stencils
     mref = np.empty(st.count)
-    reference_twist(st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1, ref.reference_twist, mref)
+    reference_twist(
+        np.stack([st.edge_e, st.edge_f], axis=1),
+        np.stack([st.sign_e, st.sign_f], axis=1),
+        t,
+        d1,
+        ref.reference_twist,
+        mref,
+    )
     return replace(ref, positions=pos, tangents=t, directors=d1, reference_twist=mref)
 
 
@@ -414,8 +425,14 @@ def heat_lattice(
     options = RAMP_OPTIONS if options is None else options
     sup = _supports(lattice, supports)
     stiffness, fm = default_stiffness(act, stiffness)
+    phase_log.info(
+        "set-up: rod model of %s nodes (stencils, %s stiffness)",
+        f"{lattice.network.n_nodes:,}",
+        stiffness,
+    )
     lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
     loads = Loads(gravity=gravity)
+    phase_log.info("set-up: perturbed flat start")
     dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
     initial = perturbed_state(lm.model, dz)
     settings = _contact_settings(lattice, initial.positions, contact, floor, friction)
@@ -430,10 +447,12 @@ def heat_lattice(
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
 
     def solve(p: float, state: State) -> StaticResult:
+        phase_log.info("natural field (%s) at %g", act.name, p)
+        model = act.natural(lm, p)
+        if not events:
+            phase_log.info("set-up: Hessian sparsity pattern and ordering; then Newton solves")
         try:
-            res = solve_static(
-                act.natural(lm, p), sup, loads, initial=state, options=options, contact=settings
-            )
+            res = solve_static(model, sup, loads, initial=state, options=options, contact=settings)
         except ConvergenceError as err:
             events.append((p, int(getattr(err.result, "iterations", 0)), False))
             raise
@@ -441,6 +460,7 @@ def heat_lattice(
         return res
 
     path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
+    phase_log.info("analysis: areas, surface fits, edge ratios, clearances")
     ref = lattice.network.nodes
     loop = lattice_boundary_loop(lattice.edge_chains, lattice.n)
     positions = np.stack([ref] + [r.positions for r in path.results])

@@ -16,18 +16,44 @@ distort the section and are ignored by rod theory.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.mesh import SectionMesh, disk_mesh
 from rotomorph.materials.section import AxialSection, axial_section, phase_constant
 from rotomorph.materials.torsion import TorsionSection, torsion_section
 
 DEFAULT_RESOLUTION = 96
+
+#: Print states a section remembers (about 200 bytes each); the memory is emptied when full.
+SOLVED_STATES_LIMIT = 1 << 16
+
+#: Print states evaluated per batch of eigenfields (bounds the ``(batch, Q, 2)`` temporaries).
+_BATCH = 512
+
+
+def unique_rows(table: FloatArray) -> tuple[FloatArray, IntArray]:
+    """Distinct rows of a float table ``(n, k)`` (exact comparison) and the inverse map ``(n,)``.
+
+    Rows are equal when every entry compares equal (so −0.0 and +0.0 are one value); the first
+    row of each group in sorted order represents it. Equivalent to
+    ``np.unique(table, axis=0, return_inverse=True)``, with a lexicographic sort of the columns
+    instead of a sort of opaque row records (which is many times slower).
+    """
+    table = np.asarray(table, dtype=float)
+    if len(table) == 0:
+        return table.reshape(0, table.shape[1]), np.zeros(0, dtype=np.int64)
+    order = np.lexsort(table.T[::-1])
+    ordered = table[order]
+    new = np.ones(len(table), dtype=bool)
+    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    inverse = np.empty(len(table), dtype=np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    return ordered[new], inverse
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,6 +69,15 @@ class FilamentSection:
     mesh: SectionMesh
     axial: AxialSection
     torsion: TorsionSection
+    _solved: dict[bytes, FloatArray] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    @property
+    def solved_states(self) -> int:
+        """Distinct print states this section has evaluated and remembers (see
+        :meth:`natural_strains`)."""
+        return len(self._solved)
 
     @property
     def axial_stiffness(self) -> float:
@@ -100,18 +135,35 @@ class FilamentSection:
         """Natural axial strain ε_c ``(n,)``, curvature ``(n, 2)`` (1/mm, toward m1, m2) and twist
         increment Δτ ``(n,)`` (1/mm) for the given print/strain state (see :meth:`eigenfields`).
         """
-        # filaments repeat a few print states along thousands of edges: evaluate each once
+        # the lines of a lattice and the cells of a filament repeat a few thousand print states
+        # over hundreds of thousands of vertices: evaluate each distinct state (exact key: the
+        # four floats, +0.0 for -0.0) once per section, and remember it for later calls
         cols = np.broadcast_arrays(
             *(np.atleast_1d(np.asarray(a, dtype=float)) for a in
               (omega_star, eps_parallel, eps_perpendicular, eps_passive))
         )  # fmt: skip
-        states, inverse = np.unique(np.column_stack(cols), axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1)
+        states, inverse = unique_rows(np.column_stack(cols) + 0.0)
+        keys = [row.tobytes() for row in states]
+        missing = [i for i, key in enumerate(keys) if key not in self._solved]
+        if len(self._solved) + len(missing) > SOLVED_STATES_LIMIT:
+            self._solved.clear()
+            missing = list(range(len(keys)))
+        for lo in range(0, len(missing), _BATCH):
+            batch = missing[lo : lo + _BATCH]
+            solved = self._solve_states(states[batch])
+            self._solved.update(zip((keys[i] for i in batch), solved, strict=True))
+        table = np.array([self._solved[key] for key in keys]).reshape(len(keys), 4)[inverse]
+        return table[:, 0], table[:, 1:3], table[:, 3]
+
+    def _solve_states(self, states: FloatArray) -> FloatArray:
+        """``(m, 4)`` rows (ε_c, κ1, κ2, Δτ) of distinct print states ``(m, 4)``."""
         eps_zz, gamma = self.eigenfields(*states.T)
-        return (
-            self.axial.natural_strain(eps_zz)[inverse],
-            self.axial.natural_curvature(eps_zz)[inverse],
-            self.torsion.natural_twist(gamma)[inverse],
+        return np.column_stack(
+            [
+                self.axial.natural_strain(eps_zz),
+                self.axial.natural_curvature(eps_zz),
+                self.torsion.natural_twist(gamma),
+            ]
         )
 
 

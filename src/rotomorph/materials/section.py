@@ -95,13 +95,15 @@ class AxialSection:
     def natural_strain(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
         """ε_c = ∫E ε*_zz dA / A_E (dimensionless); ``(...)`` for values ``(..., Q)``."""
         eps = evaluate(eigenstrain, self.points, self.active)
-        return eps @ (self.modulus * self.weights) / self.axial_stiffness
+        # einsum, not a BLAS product: each field's value does not depend on the others in the
+        # batch (bit for bit), so remembered print states equal freshly evaluated ones
+        return np.einsum("...q,q->...", eps, self.modulus * self.weights) / self.axial_stiffness
 
     def natural_curvature(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
         """κ̄ = −I_E⁻¹ ∫E ε*_zz (x − c) dA (1/mm), components toward (m1, m2): ``(..., 2)``."""
         eps = evaluate(eigenstrain, self.points, self.active)
         lever = (self.modulus * self.weights)[:, None] * (self.points - self.centroid)
-        moment = eps @ lever
+        moment = np.einsum("...q,qk->...k", eps, lever)  # batch-independent (natural_strain)
         # float64 inputs give a float64 solution (the stubs only promise "floating")
         return cast(FloatArray, -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0])
 

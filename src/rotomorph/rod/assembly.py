@@ -73,13 +73,18 @@ def material_frames(t, d1, theta, m1, m2):
 
 
 @njit(cache=_CACHE)
-def reference_twist(st_edge_e, st_edge_f, st_sign_e, st_sign_f, t, d1, mref_old, mref_new):
-    """Reference twist of every stencil, unwrapped to within pi of ``mref_old`` (rad)."""
-    for s in range(st_edge_e.shape[0]):
-        ea = st_edge_e[s]
-        fb = st_edge_f[s]
-        se = st_sign_e[s]
-        sf = st_sign_f[s]
+def reference_twist(st_edges, st_signs, t, d1, mref_old, mref_new):
+    """Reference twist of every stencil, unwrapped to within pi of ``mref_old`` (rad).
+
+    ``st_edges`` (S, 2) = (edge_e, edge_f) and ``st_signs`` (S, 2) packed as in
+    :func:`evaluate_network`, so the Python callers and the compiled one share one compiled
+    specialisation (column slices would be non-contiguous arrays, a second one).
+    """
+    for s in range(st_edges.shape[0]):
+        ea = st_edges[s, 0]
+        fb = st_edges[s, 1]
+        se = st_signs[s, 0]
+        sf = st_signs[s, 1]
         te = (se * t[ea, 0], se * t[ea, 1], se * t[ea, 2])
         tf = (sf * t[fb, 0], sf * t[fb, 1], sf * t[fb, 2])
         pu = _transport(_row(d1, ea), te, tf)
@@ -288,9 +293,7 @@ def evaluate_network(
     per-call overhead of many array arguments out of the Newton loop.
     """
     transport_frames(pos, edges, t_base, d1_base, t, d1)
-    reference_twist(
-        st_edges[:, 0], st_edges[:, 1], st_signs[:, 0], st_signs[:, 1], t, d1, mref_base, mref
-    )
+    reference_twist(st_edges, st_signs, t, d1, mref_base, mref)
     material_frames(t, d1, theta, m1, m2)
     return assemble(
         pos,

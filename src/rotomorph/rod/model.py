@@ -247,10 +247,8 @@ class Model:
         st = self.stencils
         mref = np.empty(st.count)
         reference_twist(
-            st.edge_e,
-            st.edge_f,
-            st.sign_e,
-            st.sign_f,
+            np.stack([st.edge_e, st.edge_f], axis=1),
+            np.stack([st.sign_e, st.sign_f], axis=1),
             t,
             np.array(self.directors),
             np.zeros(st.count),

@@ -78,57 +78,57 @@ def build_stencils(network: Network) -> Stencils:
 
 
 def _build_stencils(network: Network) -> Stencils:
-    edges = network.edges
-    incident: list[list[int]] = [[] for _ in range(network.n_nodes)]
-    for j, (a, b) in enumerate(edges):
-        incident[a].append(j)
-        incident[b].append(j)
-    rows: list[tuple[int, int, int, int, int, float, float, bool]] = []
-    for n, inc in enumerate(incident):
-        k = len(inc)
-        if k < 2:
-            continue
-        if not network.branch[n] and k > 2:
-            raise InvalidDesignError(
-                "Network.branch",
-                f"node {n} joins {k} segments but is not flagged as a branch node",
-            )
-        pairs = (
-            [_rod_vertex_pair(edges, n, inc[0], inc[1])]
-            if k == 2 and not network.branch[n]
-            else [(inc[p], inc[q]) for p in range(k) for q in range(p + 1, k)]
+    edges = np.asarray(network.edges, dtype=np.int64)
+    branch = np.asarray(network.branch, dtype=bool)
+    # incidence grouped by node, each node's segments in index order
+    node_of = edges.ravel()
+    edge_of = np.repeat(np.arange(len(edges), dtype=np.int64), 2)
+    order = np.lexsort((edge_of, node_of))
+    node_of, edge_of = node_of[order], edge_of[order]
+    degree = np.bincount(node_of, minlength=network.n_nodes)
+    first = np.concatenate([[0], np.cumsum(degree)[:-1]])
+    bad = np.flatnonzero(~branch & (degree > 2))
+    if len(bad):
+        raise InvalidDesignError(
+            "Network.branch",
+            f"node {int(bad[0])} joins {int(degree[bad[0]])} segments but is not flagged as a "
+            "branch node",
         )
-        for a, b in pairs:
-            sa = 1.0 if edges[a, 1] == n else -1.0
-            sb = 1.0 if edges[b, 0] == n else -1.0
-            far_a = edges[a, 0] if sa > 0 else edges[a, 1]
-            far_b = edges[b, 1] if sb > 0 else edges[b, 0]
-            rows.append((far_a, n, far_b, a, b, sa, sb, bool(network.branch[n])))
-    if not rows:
+    # one pair per rod vertex, every pair (p < q, in segment order) at a branch node
+    centre, seg_a, seg_b = [], [], []
+    for k in np.unique(degree[degree >= 2]):
+        nodes = np.flatnonzero(degree == k)
+        inc = edge_of[first[nodes][:, None] + np.arange(k)]
+        p, q = np.triu_indices(int(k), 1)
+        centre.append(np.repeat(nodes, len(p)))
+        seg_a.append(inc[:, p].ravel())
+        seg_b.append(inc[:, q].ravel())
+    if not centre:
         raise InvalidDesignError(
             "Network", "has no node joining two segments; a rod needs N >= 3 nodes"
         )
-    arr = np.array([r[:5] for r in rows], dtype=np.int64)
+    by_node = np.argsort(np.concatenate(centre), kind="stable")
+    n = np.concatenate(centre)[by_node]
+    a = np.concatenate(seg_a)[by_node]
+    b = np.concatenate(seg_b)[by_node]
+    # a rod vertex lists a segment pointing into the node first: segments are listed by
+    # index, so where a ring closes (node 0 of Network.ring: segment 0 leaves it, the last
+    # segment enters it) the pair would otherwise be seen reversed on both sides; ordered, the
+    # closing vertex is a vertex like any other, with the ring's orientation
+    swap = ~branch[n] & (edges[a, 1] != n) & (edges[b, 1] == n)
+    a, b = np.where(swap, b, a), np.where(swap, a, b)
+    into_a = edges[a, 1] == n
+    out_b = edges[b, 0] == n
+    far_a = np.where(into_a, edges[a, 0], edges[a, 1])
+    far_b = np.where(out_b, edges[b, 1], edges[b, 0])
     return Stencils(
-        nodes=arr[:, :3].copy(),
-        edge_e=arr[:, 3].copy(),
-        edge_f=arr[:, 4].copy(),
-        sign_e=np.array([r[5] for r in rows]),
-        sign_f=np.array([r[6] for r in rows]),
-        junction=np.array([r[7] for r in rows], dtype=bool),
+        nodes=np.column_stack([far_a, n, far_b]),
+        edge_e=a,
+        edge_f=b,
+        sign_e=np.where(into_a, 1.0, -1.0),
+        sign_f=np.where(out_b, 1.0, -1.0),
+        junction=branch[n].copy(),
     )
-
-
-def _rod_vertex_pair(edges: IntArray, n: int, a: int, b: int) -> tuple[int, int]:
-    """Order the two segments of a rod vertex so that one pointing into the node comes first.
-
-    Segments are listed by index, so where a ring closes (node 0 of ``Network.ring``: segment 0
-    leaves it, the last segment enters it) the pair would otherwise be seen reversed on both
-    sides; ordered, the closing vertex is a vertex like any other, with the ring's orientation.
-    """
-    if edges[a, 1] != n and edges[b, 1] == n:
-        return b, a
-    return a, b
 
 
 @dataclass(frozen=True, eq=False)

@@ -337,15 +337,16 @@ def _simulate_lattice(
     lat = design.lattice
     size = design_size(design)
     phase_log.info(
-        "set-up: %dx%d lattice, %s rod nodes (estimated ~%.1f GB, ~%.0f s)",
+        "set-up: %dx%d lattice geometry, %s rod nodes (estimated ~%.1f GB, ~%.0f s); "
+        "%d heating step(s)",
         lat.n,
         lat.n,
         f"{size.nodes:,}",
         size.memory_bytes / 1e9,
         size.setup_seconds,
+        steps,
     )
     lattice = lat.to_lattice()
-    phase_log.info("set-up: rod model, sparsity pattern; then solving %d heating step(s)", steps)
     rule = _lattice_actuation(actuation, start_temperature, temperature, model)
     hot = float(getattr(rule, "end", ACTUATION_TEMPERATURE))  # x-readings: the paper's 175 °C
     res = heat_lattice(

@@ -20,7 +20,7 @@ n = cos β m1 + sin β m2.
 
 from __future__ import annotations
 
-import itertools
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -35,6 +35,7 @@ __all__ = [
     "active_normals",
     "chain_clearance",
     "chain_segments",
+    "chains_segments",
     "describe_run",
     "material_twist",
 ]
@@ -42,9 +43,25 @@ __all__ = [
 
 def chain_segments(edges: IntArray, chain: IntArray) -> IntArray:
     """Segment index of each consecutive node pair of ``chain`` (−1 where none exists)."""
-    lookup = {(int(a), int(b)): j for j, (a, b) in enumerate(edges)}
-    lookup.update({(int(b), int(a)): j for j, (a, b) in enumerate(edges)})
-    return np.array([lookup.get((int(a), int(b)), -1) for a, b in itertools.pairwise(chain)])
+    return chains_segments(edges, [chain])[0]
+
+
+def chains_segments(edges: IntArray, chains: Sequence[IntArray]) -> list[IntArray]:
+    """:func:`chain_segments` of many chains at once (one sorted lookup, not one per chain)."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    chains = [np.asarray(c, dtype=np.int64).reshape(-1) for c in chains]
+    size = 1 + max([int(edges.max(initial=0))] + [int(c.max(initial=0)) for c in chains])
+    key = np.sort(edges, axis=1) @ np.array([size, 1])
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    a = np.concatenate([c[:-1] for c in chains] + [np.zeros(0, dtype=np.int64)])
+    b = np.concatenate([c[1:] for c in chains] + [np.zeros(0, dtype=np.int64)])
+    query = np.minimum(a, b) * size + np.maximum(a, b)
+    pos = np.searchsorted(sorted_key, query, side="right") - 1  # the last such segment
+    hit = pos >= 0
+    hit[hit] = sorted_key[pos[hit]] == query[hit]
+    seg = np.where(hit, order[np.maximum(pos, 0)], -1)
+    return np.split(seg, np.cumsum([max(len(c) - 1, 0) for c in chains])[:-1])
 
 
 def active_normals(states: tuple[Any, ...], printed_normals: FloatArray) -> tuple[FloatArray, ...]:
@@ -80,8 +97,7 @@ def material_twist(
 ) -> FloatArray:
     """Material twist per node ``(S, N)`` (1/mm) along ``chains``; NaN at chain ends."""
     out = np.full(positions.shape[:2], np.nan)
-    for chain in chains:
-        seg = chain_segments(edges, chain)
+    for chain, seg in zip(chains, chains_segments(edges, chains), strict=True):
         if len(chain) < 3 or (seg < 0).any():
             continue
         for k in range(len(positions)):
@@ -197,8 +213,7 @@ def _lattice_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, l
     arc = np.full(n, np.nan)
     node_edge = np.full(n, -1, dtype=np.int64)
     printed = np.asarray(sim.positions[0])
-    for j, chain in enumerate(chains):
-        seg = chain_segments(edges, chain)
+    for j, (chain, seg) in enumerate(zip(chains, chains_segments(edges, chains), strict=True)):
         lattice_edge[seg[seg >= 0]] = j
         inner = chain[1:-1]
         node_edge[inner] = j

@@ -172,6 +172,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     """
     opt = options or NewtonOptions()
     x = np.array(x0, dtype=float)
+    log.debug("newton: start, %d unknowns", len(x))
     f, g, H = obj.evaluate(x, True, True)
     M = obj.metric()
     w = obj.weights()

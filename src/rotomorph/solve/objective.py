@@ -28,6 +28,7 @@ from rotomorph.rod.state import State
 from rotomorph.solve.contact_term import ContactTerm, HessianPattern, tangent_rigid_modes
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.loads import Loads, Supports
+from rotomorph.solve.pattern import hessian_pattern
 from rotomorph.solve.retraction import (
     EdgeRotationRetraction,
     max_edge_rotation,
@@ -269,9 +270,7 @@ class RodObjective:
         transport_frames(pos, self._edges, self.base.tangents, self.base.directors, t, d1)
         st = self.model.stencils
         mref = np.empty(st.count)
-        reference_twist(
-            st.edge_e, st.edge_f, st.sign_e, st.sign_f, t, d1, self.base.reference_twist, mref
-        )
+        reference_twist(self._st_edges, self._st_signs, t, d1, self.base.reference_twist, mref)
         return State(positions=pos, theta=theta, tangents=t, directors=d1, reference_twist=mref)
 
     def accept(self, q: FloatArray) -> None:
@@ -621,25 +620,7 @@ def _topology(model: Model, fixed: BoolArray) -> dict:
     bandwidth = int(max(spans)) if spans else 0
     topo: dict = {"bandwidth": bandwidth, "banded": bandwidth <= BANDED_LIMIT, "sparse": None}
     if not topo["banded"]:
-        nfree = len(free)
-        rows = np.concatenate(
-            [np.repeat(rs, 11, axis=1).ravel(), np.repeat(re_, 6, axis=1).ravel()]
-        )
-        cols = np.concatenate([np.tile(rs, (1, 11)).ravel(), np.tile(re_, (1, 6)).ravel()])
-        ok = (rows >= 0) & (cols >= 0)
-        keys = cols[ok] * nfree + rows[ok]
-        uniq, inv = np.unique(keys, return_inverse=True)
-        slots = -np.ones(len(rows), dtype=np.int64)
-        slots[ok] = inv
-        ns = st.count * 121
-        indices = (uniq % nfree).astype(np.int32)
-        counts = np.bincount(uniq // nfree, minlength=nfree)
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
-        topo["sparse"] = (
-            slots[:ns].reshape(-1, 11, 11),
-            slots[ns:].reshape(-1, 6, 6),
-            (indices, indptr),
-        )
+        topo["sparse"] = hessian_pattern(lay.stencil_dofs(st), lay.edge_dofs(net.edges), reduced)
     fixed_nodes = np.flatnonzero(fixed[lay.pos[:, None] + np.arange(3)].all(axis=1))
     topo["retraction"] = EdgeRotationRetraction(
         np.ascontiguousarray(net.edges), net.n_nodes, fixed_nodes

@@ -1,0 +1,92 @@
+"""The program actuation evaluates each distinct print state once, and exactly.
+
+The lines of a lattice repeat a few thousand cross-section print states (rotation number,
+LCE and passive strains) over all their vertices; the section solves each distinct one once and
+remembers it (:meth:`rotomorph.materials.janus.FilamentSection.natural_strains`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.lattice.actuation import ProgramActuation
+from rotomorph.lattice.model import lattice_model
+from rotomorph.materials.janus import FilamentSection, unique_rows
+from rotomorph.materials.material import get_material
+from rotomorph.materials.natural import FilamentModel
+
+
+def _natural(
+    monkeypatch: pytest.MonkeyPatch, n: int, memo: bool, clear: bool = True
+) -> tuple[Any, list[np.ndarray], int]:
+    """Natural model of an n x n lattice at 150 °C, every state row asked for, rows solved
+    (``clear``: forget what the section remembers first)."""
+    asked: list[np.ndarray] = []
+    solved = [0]
+    natural_strains = FilamentSection.natural_strains
+    solve_states = FilamentSection._solve_states
+
+    def record(self: FilamentSection, *args: Any) -> tuple[Any, Any, Any]:
+        cols = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in args))
+        asked.append(np.column_stack(cols) + 0.0)
+        if memo:
+            return natural_strains(self, *args)
+        rows = solve_states(self, asked[-1])  # every row on its own: no deduplication
+        return rows[:, 0], rows[:, 1:3], rows[:, 3]
+
+    def count(self: FilamentSection, states: np.ndarray) -> np.ndarray:
+        solved[0] += len(states)
+        return solve_states(self, states)
+
+    lattice = sinusoidal_lattice(n)
+    section = FilamentModel().section(
+        get_material(lattice.active_material),
+        get_material(lattice.passive_material),
+        lattice.radius,
+        lattice.active_fraction,
+    )
+    if clear:
+        section._solved.clear()  # a section remembers states across calls: start empty
+    monkeypatch.setattr(FilamentSection, "natural_strains", record)
+    monkeypatch.setattr(FilamentSection, "_solve_states", count)
+    lm = lattice_model(lattice, stiffness="janus")
+    model = ProgramActuation().natural(lm, 150.0)
+    return model, asked, solved[0]
+
+
+def test_each_distinct_print_state_is_solved_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    _, asked, solved = _natural(monkeypatch, 6, memo=True)
+    # one solve per distinct state over ALL lines and calls
+    assert solved == len(unique_rows(np.concatenate(asked))[0])
+    per_call = sum(len(unique_rows(rows)[0]) for rows in asked)
+    assert solved * 2 < per_call  # deduplicating within each line's call only solves more
+
+
+def test_remembered_states_give_the_same_field_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    cached, _, _ = _natural(monkeypatch, 5, memo=True)
+    monkeypatch.undo()
+    again, _, solved_again = _natural(monkeypatch, 5, memo=True, clear=False)
+    assert solved_again == 0  # every state remembered from the first call
+    monkeypatch.undo()
+    direct, _, _ = _natural(monkeypatch, 5, memo=False)
+    for name in ("natural_curvature1", "natural_curvature2", "natural_twist", "rest_length"):
+        assert np.array_equal(getattr(cached, name), getattr(direct, name)), name
+        assert np.array_equal(getattr(again, name), getattr(direct, name)), name
+
+
+def test_unique_rows_matches_numpy() -> None:
+    rng = np.random.default_rng(3)
+    table = rng.choice([-1.5, -0.0, 0.0, 0.25, 2.0], size=(400, 4))
+    states, inverse = unique_rows(table)
+    expected, expected_inverse = np.unique(table, axis=0, return_inverse=True)
+    assert np.array_equal(states, expected)
+    assert np.array_equal(inverse, expected_inverse.reshape(-1))
+    assert np.array_equal(states[inverse], table)
+    empty_states, empty_inverse = unique_rows(np.zeros((0, 4)))
+    assert empty_states.shape == (0, 4) and empty_inverse.shape == (0,)
