@@ -1,6 +1,7 @@
 """Contact benchmark: heating ramps and rods with contact switched on (JSON lines on stdout).
 
-One line per case with ``case``, ``n_nodes``, ``wall_s``, ``newton_iterations``,
+One line per case with ``case``, ``n_nodes``, ``wall_s``, ``cpu_s`` (this process's CPU time:
+the cost on one core, whatever the load), ``newton_iterations``,
 ``min_clearance_ratio`` (smallest centre-line distance over ``r_a + r_b`` of the pairs allowed
 to touch, over every ramp step), ``contacts_active`` (at the end), ``stable`` and, for
 lattices, ``area_ratio`` and ``gaussian_sign``:
@@ -12,10 +13,12 @@ lattices, ``area_ratio`` and ``gaussian_sign``:
 * ``composite-coil``: the composite filament (active fraction 0.5) at ω* = 0.06, heated to
   175 °C with self-contact;
 * ``contracting-sinusoid``: the paper's contracting sinusoid with self-contact;
-* ``euler-3x``: a perfectly straight clamped column under 3 x its Euler load;
+* ``euler-3x``: the perfectly straight clamped-free column of ``EulerColumnCase`` under
+  3 x its Euler load, with its elastica tip;
 * ``contact-overhead``: wall time of the expanding 5 x 5 ramp with contact on / off.
 
-Run: ``python benchmarks/contact.py [--quick]`` (``--quick``: 4-step ramps).
+Run: ``python benchmarks/contact.py [--quick] [CASE ...]`` (``--quick``: 4-step ramps; cases
+by name, default all).
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from rotomorph.contact import Contact
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.lattice import heat_lattice
 from rotomorph.lattice.heating import lattice_gravity
-from rotomorph.rod.model import Model
+from rotomorph.rod.cases import EulerColumnCase
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.static import solve_static
 
@@ -46,9 +49,9 @@ def _stable(res) -> bool | None:  # type: ignore[no-untyped-def]
 
 def lattice_case(pattern: str, steps: int) -> dict:
     lat = sinusoidal_lattice(pattern=pattern)
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     res = heat_lattice(lat, steps=steps, floor=True, gravity=lattice_gravity(lat))
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     row = {
         "case": f"{pattern}-5x5",
         "n_nodes": int(lat.network.n_nodes),
@@ -57,6 +60,7 @@ def lattice_case(pattern: str, steps: int) -> dict:
         "buoyant_gravity": True,
         "actuation": res.actuation,
         "wall_s": round(wall, 3),
+        "cpu_s": round(cpu, 3),
         "newton_iterations": int(res.total_iterations),
         "min_clearance_ratio": round(float(res.min_clearance.min()), 5),
         "contacts_active": int(res.contacts_active[-1]),
@@ -74,9 +78,9 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
     from rotomorph.simulate.filament import simulate_filament
 
     contact = Contact(radius=radius)
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     sim = simulate_filament(program, steps=steps, contact=contact)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     from rotomorph.contact import ContactPotential
     from rotomorph.design.network import Network
 
@@ -86,58 +90,61 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
         "n_nodes": len(sim.printed),
         "steps": steps,
         "wall_s": round(wall, 3),
+        "cpu_s": round(cpu, 3),
         "newton_iterations": int(sim.iterations.sum()),
         "min_clearance_ratio": round(min(pot.clearance(p) for p in sim.positions), 5),
         "contacts_active": int(pot.active_contacts(sim.positions[-1])),
-        "stable": None,
+        "stable": _stable(sim),
         "end_to_end_ratio": round(float(sim.final_ratio), 4),
     }
 
 
 def euler_case() -> dict:
-    n, length, r = 41, 20.0, 0.3
-    EI = np.pi * r**4 / 4
-    pts = np.stack([np.zeros(n), np.zeros(n), np.linspace(0, length, n)], 1)
-    model = Model.chain(
-        pts,
-        bending_stiffness1=EI,
-        bending_stiffness2=EI,
-        twist_stiffness=EI / 1.5,
-        axial_stiffness=1e3 * EI,
+    """The clamped-free column of :class:`~rotomorph.rod.cases.EulerColumnCase` (first edge
+    clamped, centred on the origin, so the free length is exact), started exactly straight at
+    3 x its Euler load, with self-contact; compared with the elastica's tip."""
+    case, n, ratio = EulerColumnCase(), 41, 3.0
+    loads = Loads(forces=((n - 1, (-ratio * case.euler_load, 0.0, 0.0)),))
+    c0, t0 = time.process_time(), time.perf_counter()
+    res = solve_static(
+        case.model(n), Supports.clamp_ends(n), loads, contact=Contact(radius=case.radius)
     )
-    critical = np.pi**2 * EI / (4 * length**2)  # clamped-free column
-    loads = Loads(forces=((n - 1, (0.0, 0.0, -3.0 * critical)),))
-    t0 = time.perf_counter()
-    res = solve_static(model, Supports.clamp_ends(n), loads, contact=Contact(radius=r))
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     tip = res.positions[-1]
+    x_ref, y_ref = case.elastica_tip(ratio)
     return {
         "case": "euler-3x",
         "n_nodes": n,
         "wall_s": round(wall, 3),
+        "cpu_s": round(cpu, 3),
         "newton_iterations": int(res.iterations),
         "min_clearance_ratio": round(float(res.contact.clearance(res.positions)), 5),
         "contacts_active": int(res.contact.active_contacts(res.positions)),
-        "stable": bool(getattr(res, "stable", False)),
-        "buckled": bool(np.hypot(tip[0], tip[1]) > 0.01 * length),
-        "tip_deflection_mm": round(float(np.hypot(tip[0], tip[1])), 4),
-        "tip_height_ratio": round(float(tip[2] / length), 4),
+        "stable": bool(res.stable),
+        "buckled": bool(np.hypot(tip[1], tip[2]) > 0.01 * case.length),
+        "tip_lateral_ratio": round(float(np.hypot(tip[1], tip[2]) / case.length), 4),
+        "tip_lateral_elastica": round(y_ref, 4),
+        "tip_axial_ratio": round(float(tip[0] / case.length), 4),
+        "tip_axial_elastica": round(x_ref, 4),
     }
 
 
 def overhead_case(steps: int) -> dict:
     lat = sinusoidal_lattice(pattern="expanding")
-    t0 = time.perf_counter()
+    c0, t0 = time.process_time(), time.perf_counter()
     off = heat_lattice(lat, steps=steps)
-    t_off = time.perf_counter() - t0
-    t0 = time.perf_counter()
+    c_off, t_off = time.process_time() - c0, time.perf_counter() - t0
+    c0, t0 = time.process_time(), time.perf_counter()
     on = heat_lattice(lat, steps=steps, contact=True)
-    t_on = time.perf_counter() - t0
+    c_on, t_on = time.process_time() - c0, time.perf_counter() - t0
     return {
         "case": "contact-overhead",
         "ratio": round(t_on / t_off, 3),
+        "cpu_ratio": round(c_on / c_off, 3),
         "wall_off_s": round(t_off, 3),
         "wall_on_s": round(t_on, 3),
+        "cpu_off_s": round(c_off, 3),
+        "cpu_on_s": round(c_on, 3),
         "newton_iterations_off": int(off.total_iterations),
         "newton_iterations_on": int(on.total_iterations),
         "min_clearance_ratio": round(float(on.min_clearance.min()), 5),
@@ -145,28 +152,37 @@ def overhead_case(steps: int) -> dict:
     }
 
 
-def main(quick: bool = False) -> None:
+def main(quick: bool = False, only: tuple[str, ...] = ()) -> None:
     from rotomorph.io.designfile import Filament
     from rotomorph.simulate.validation import FILAMENT_SPACINGS, sinusoid_filament
 
+    def wanted(case: str) -> bool:
+        return not only or case in only
+
     steps = 4 if quick else 16
     heat_lattice(sinusoidal_lattice(n=2, ghost_nodes=2), steps=1, contact=True)  # compile
-    _emit(overhead_case(steps))
+    if wanted("contact-overhead"):
+        _emit(overhead_case(steps))
     for pattern in ("contracting", "dome", "saddle"):
-        _emit(lattice_case(pattern, steps))
-    coil = Filament(
-        speed=3.0,
-        rotation_number=0.06,
-        radius=0.3,
-        active_fraction=0.5,
-        spacing=FILAMENT_SPACINGS[0],
-        segments=[{"kind": "line", "length": 30.0}],  # type: ignore[list-item]
-    ).to_program()
-    _emit(filament_case("composite-coil", coil, 0.3, 8))
-    sinus = sinusoid_filament("inner", FILAMENT_SPACINGS[0]).to_program()
-    _emit(filament_case("contracting-sinusoid", sinus, 0.3, 8))
-    _emit(euler_case())
+        if wanted(f"{pattern}-5x5"):
+            _emit(lattice_case(pattern, steps))
+    if wanted("composite-coil"):
+        coil = Filament(
+            speed=3.0,
+            rotation_number=0.06,
+            radius=0.3,
+            active_fraction=0.5,
+            spacing=FILAMENT_SPACINGS[0],
+            segments=[{"kind": "line", "length": 30.0}],  # type: ignore[list-item]
+        ).to_program()
+        _emit(filament_case("composite-coil", coil, 0.3, 8))
+    if wanted("contracting-sinusoid"):
+        sinus = sinusoid_filament("inner", FILAMENT_SPACINGS[0]).to_program()
+        _emit(filament_case("contracting-sinusoid", sinus, 0.3, 8))
+    if wanted("euler-3x"):
+        _emit(euler_case())
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    args = sys.argv[1:]
+    main(quick="--quick" in args, only=tuple(a for a in args if not a.startswith("--")))

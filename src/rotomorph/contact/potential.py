@@ -43,7 +43,7 @@ MAX_SUBSTEPS = 100_000
 #: IPC's edge-edge mollifier threshold relative to ``|a|^2 |b|^2`` (sin² of about 1.8 degrees)
 MOLLIFIER = 1e-3
 #: default activation distance relative to the smallest contact distance
-DEFAULT_ACTIVATION = 0.01
+DEFAULT_ACTIVATION = 0.03
 
 
 _NO_INT = np.zeros(0, dtype=np.int64)
@@ -67,7 +67,7 @@ class Contact:
     self_contact
         Whether segments of the network touch each other (default True).
     activation_distance
-        Gap ``d - (r_a + r_b)`` below which the barrier acts (mm); default 1 % of the smallest
+        Gap ``d - (r_a + r_b)`` below which the barrier acts (mm); default 3 % of the smallest
         contact distance. Equilibrium gaps lie in ``(0, activation_distance)``.
     stiffness
         Barrier stiffness κ (N/mm⁵); default: chosen by the solver from the problem's force
