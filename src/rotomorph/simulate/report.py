@@ -323,28 +323,50 @@ def _lattice_section(
     coarse_g, fine_g = LATTICE_GHOSTS[quick]
     for pattern in ("expanding", "contracting", "dome", "saddle"):
         results[pattern] = _heat(pattern, quick, steps, model, coarse_g)
-        if pattern in ("expanding", "contracting"):
+        if quick and pattern in ("expanding", "contracting"):
             fine[pattern] = _heat(pattern, quick, steps, model, fine_g)[1]
         tick()
-    # contact-resolved ramps: self-contact, resting on the bath floor under buoyant weight
-    # (the expanding lattice never comes within a diameter: it needs none)
-    # (left out in quick mode, whose 3 x 3 smoke run must stay fast: signs then come from the
-    # ramps without contact and say so)
+    # contact-resolved ramps: self-contact, resting on the bath floor under buoyant weight.
+    # These are the physical states, so the counted areas come from them (at two resolutions).
+    # Left out in quick mode, whose 3 x 3 smoke run must stay fast: its rows come from the
+    # ramps without contact and say so.
     resolved = (
         {}
         if quick
         else {
             p: _heat(p, quick, steps, model, coarse_g, contact=True)
-            for p in ("contracting", "dome", "saddle")
+            for p in ("expanding", "contracting", "dome", "saddle")
         }
     )
+    if not quick:
+        for pattern in ("expanding", "contracting"):
+            fine[pattern] = _heat(pattern, quick, steps, model, fine_g, contact=True)[1]
     # Fig. 3G: area
     fig = new_figure(6.0, 4.2)
     ax = fig.add_subplot()
     for i, pattern in enumerate(("expanding", "contracting")):
         lattice, res, why = results[pattern]
+        touched = resolved.get(pattern, (None, None, ""))[1]
+        counted_res = res if quick else touched
         measured = 1.0 + float(table.value[i]) / 100.0
         spread = float(table.spread[i]) / 100.0
+        if quick:
+            how = (
+                f"quick mode: no contact (min clearance {np.min(res.min_clearance):.2f} diameters)"
+                if res is not None
+                else ""
+            )
+        else:
+            how = (
+                "self-contact (centre lines never closer than a diameter: min clearance "
+                f"{np.min(touched.min_clearance):.3f}) and the bath floor under buoyant "
+                f"weight; {int(touched.contacts_active[-1])} contacts at "
+                f"{touched.parameter[-1]:.0f} °C; largest rise off the floor "
+                f"{float(touched.floor_lift[-1]):.2f} mm; sd propagated through the same "
+                "lattice without contact"
+                if touched is not None
+                else ""
+            )
         rows.append(
             _row(
                 "lattice_area_ratio",
@@ -355,7 +377,7 @@ def _lattice_section(
                 predicted_sd=None
                 if quick or res is None
                 else _area_sd(fit, pattern, quick, coarse_g),
-                other=None if res is None else res.final_area_ratio,
+                other=None if counted_res is None else counted_res.final_area_ratio,
                 resolution=(coarse_g, fine_g),
                 resolution_unit="ghost nodes per edge",
                 calibrated_without="lattice_area (never fitted)",
@@ -365,28 +387,35 @@ def _lattice_section(
                 or f"{size} lattice heated {res.parameter[0]:.0f} → {res.parameter[-1]:.0f} °C "
                 f"through the calibrated materials chain ('{res.actuation}'); sd by one-sided "
                 f"secants at {coarse_g} ghost nodes (none in quick mode); measured A/A0 = 1 + "
-                "change (%)/100; "
-                f"no contact in this row (min clearance {np.min(res.min_clearance):.2f} "
-                "diameters; the contact-resolved value is the next row where they touch)",
+                f"change (%)/100; {how}",
+                physical=(
+                    (res is not None and float(np.min(res.min_clearance)) >= 1.0)
+                    if quick
+                    else touched is not None
+                ),
             )
         )
-        touched = resolved.get(pattern, (None, None, ""))[1]
-        if touched is not None:
+        if not quick and res is not None:
+            clearance = float(np.min(res.min_clearance))
+            overlap = clearance < 1.0
             rows.append(
                 _row(
                     "lattice_area_ratio",
-                    f"{table.condition[i]}, contact-resolved on the bath floor",
+                    f"{table.condition[i]}, without contact",
                     measured,
                     spread,
-                    float(touched.final_area_ratio),
+                    float(res.final_area_ratio),
                     counted=False,
                     unit="1",
                     figure="fig3g_lattice_area.png",
-                    note=f"{size}; self-contact (centre lines never closer than a diameter: "
-                    f"min clearance {np.min(touched.min_clearance):.3f}) and the bath floor "
-                    f"under buoyant weight; {int(touched.contacts_active[-1])} contacts at "
-                    f"{touched.parameter[-1]:.0f} °C; largest rise off the floor "
-                    f"{float(touched.floor_lift[-1]):.2f} mm",
+                    note=f"{size}; the same ramp without a contact model: min clearance "
+                    f"{clearance:.2f} diameters"
+                    + (
+                        "; filaments pass through each other, not a physical state"
+                        if overlap
+                        else ""
+                    ),
+                    physical=not overlap,
                 )
             )
         if res is not None:
@@ -637,10 +666,9 @@ def _markdown(
             lines += ["![shapes](figures/fig2fg_shapes.png)", ""]
         if quantities[0] == "lattice_gaussian_sign":
             lines += [
-                "Views at the end of the ramp: contracting lattices, domes and saddles with "
-                "self-contact, resting on the bath floor under their buoyant weight "
-                "(filaments never pass through each other); the expanding lattice, whose "
-                "filaments never come within a diameter, without.",
+                "Views at the end of the ramp: every lattice with self-contact, resting on the "
+                "bath floor under its buoyant weight (filaments never pass through each "
+                "other).",
                 "",
             ]
             for pattern in ("expanding", "contracting", "dome", "saddle"):
@@ -697,6 +725,8 @@ def prediction_table(rows: list[dict[str, Any]], summary: dict[str, Any]) -> str
             how = "not counted"
         if r["predicted"] is not None and not r["converged"]:
             how += ", NOT converged"
+        if r.get("physical") is False:
+            how += ", NOT PHYSICAL (filaments overlap)"
         z = "—" if r["z"] is None else f"{r['z']:+.1f}"
         lines.append(
             f"| {r['quantity']} | {r['condition']} | {_pm(r['measured'], r['spread'])} | "
