@@ -111,7 +111,7 @@ def lattice_case(name: str, pattern: str, target, iterations: int) -> None:  # t
         target_metric=des.target_gaussian_curvature,
         achieved_metric=des.achieved_gaussian_curvature,
         gaussian_curvature_error_rel=abs(
-            abs(des.achieved_gaussian_curvature) - abs(des.target_gaussian_curvature or 0.0)
+            des.achieved_gaussian_curvature - (des.target_gaussian_curvature or 0.0)
         )
         / abs(des.target_gaussian_curvature or 1.0),
         gradient_fd_rel_err=_fd_check(lat, target),

@@ -569,6 +569,9 @@ def _same_strength(
     return np.interp(wanted, strength, grid)
 
 
+#: Uniform speeds (geometrically spaced over the range) the starting pattern is tried at.
+INITIAL_SPEEDS = 5
+
 #: Factors of the overall bending strength tried about the optimised speeds (phase 5).
 STRENGTH_SCALES = (0.84, 0.92, 1.08, 1.18)
 
@@ -586,10 +589,11 @@ class _Check:
 
     @property
     def rank(self) -> tuple[bool, float]:
-        """Unstable last; then by the Gaussian-curvature error (the misfit without a K)."""
+        """Unstable last; then by the relative error of the (signed) Gaussian curvature, or
+        the misfit for targets without one."""
         if self.target_k is None:
             return (not self.stable, self.misfit)
-        err = abs(abs(self.fit.gaussian_curvature) - abs(self.target_k)) / abs(self.target_k)
+        err = abs(self.fit.gaussian_curvature - self.target_k) / abs(self.target_k)
         return (not self.stable, err)
 
 
@@ -601,15 +605,24 @@ def _verify(
     picked: IntArray,
     size: float,
     lattice: Lattice,
+    eq: _Equilibria | None = None,
 ) -> _Check:
-    fresh = _Equilibria(blend, seed=seed)
-    res = fresh(p)
+    """``p`` solved by ``eq`` (default: a fresh ramp from the flat printed state, as the
+    forward simulation runs it; else warm-started from ``eq``'s last state)."""
+    fresh = _Equilibria(blend, seed=seed) if eq is None else eq
+    before = fresh.solves
+    try:
+        res = fresh(p)
+    except ConvergenceError:
+        if eq is None:
+            raise
+        return _verify(blend, p, seed, target, picked, size, lattice)
     return _Check(
         result=res,
         misfit=_misfit(target, res.positions, picked, size)[0],
         stable=_is_minimum(fresh.rod(p), res.state),
         fit=fit_quadratic_surface(res.positions[lattice.branch_indices]),
-        solves=fresh.solves,
+        solves=fresh.solves - before,
         target_k=target.gaussian_curvature,
     )
 
@@ -663,7 +676,9 @@ def design_lattice(
 
     Notes
     -----
-    Phases: (1) L-BFGS-B on the relaxed modes and the speeds, the printability weight raised
+    Phases: (0) the starting pattern solved at its own speeds and at :data:`INITIAL_SPEEDS`
+    uniform speeds (one ramp, then warm starts), the best misfit starting the descent; (1) L-BFGS-B
+    on the relaxed modes and the speeds, the printability weight raised
     tenfold twice; (2) modes rounded to ±1 (an edge's relaxed strength kept by lowering its
     speed), the rounded optimum and the starting pattern verified by a fresh ramp; (3) with
     the best modes fixed, L-BFGS-B on the speeds alone; (4) speeds rounded to the resolution
@@ -671,9 +686,10 @@ def design_lattice(
     simulation runs it; (5) for targets with a Gaussian curvature K (dome, saddle), the
     overall bending strength is also scaled by each of :data:`STRENGTH_SCALES`, then by steps
     of 4 % and 2 % about the best scale (every edge's speed moved so that its mismatch changes
-    by that factor, rounded again); each candidate is verified the same way, and the stable
-    one whose K is closest to the target's is kept: the height misfit is nearly flat along this
-    direction at its optimum while K is not.
+    by that factor, rounded again; each solved warm-started from the base design), and the
+    stable one whose K is closest to the target's is verified by a fresh ramp and kept if it
+    still beats the base design: the height misfit is nearly flat along this direction at its
+    optimum while K is not.
 
     Raises
     ------
@@ -700,17 +716,30 @@ def design_lattice(
     else:
         c0 = np.clip(np.asarray(initial, dtype=float), -1, 1)
     v0 = lattice.speeds
-    if speed_range is None:
-        v_bounds = [(float(v), float(v)) for v in v0]
-    else:
-        v0 = np.clip(v0, *speed_range)
-        v_bounds = [(float(speed_range[0]), float(speed_range[1]))] * n_edges
-    history: list[float] = []
     picked = (
         np.asarray(lattice.branch_indices)
         if nodes == "branch"
         else np.arange(lattice.network.n_nodes)
     )
+    if speed_range is None:
+        v_bounds = [(float(v), float(v)) for v in v0]
+    else:
+        v_bounds = [(float(speed_range[0]), float(speed_range[1]))] * n_edges
+        # (0) the starting pattern at a few uniform speeds: the best one starts the descent
+        # (K is far from monotonic in the speed, so the lattice's own speed may start far off)
+        starts = [np.clip(v0, *speed_range)] + [
+            np.full(n_edges, v) for v in np.geomspace(*speed_range, INITIAL_SPEEDS)
+        ]
+        signs0 = np.where(c0 >= 0, 1.0, -1.0)
+        scan = _Equilibria(blend, seed=seed)  # one ramp, then warm starts along the speeds
+        tried0 = [
+            _verify(blend, np.concatenate([signs0, v]), seed, target, picked, size, lattice, scan)
+            for v in starts
+        ]
+        eq.solves += sum(t.solves for t in tried0)
+        k0 = min(range(len(starts)), key=lambda i: (not tried0[i].stable, tried0[i].misfit))
+        v0 = starts[k0]
+    history: list[float] = []
     weight = [printability]
 
     def fun(p: FloatArray) -> tuple[float, FloatArray]:
@@ -786,16 +815,23 @@ def design_lattice(
     # verification as the forward simulation does it: a fresh ramp from the flat printed state
     base = speeds
 
+    near = _Equilibria(blend, seed=seed)
+
     def check_scale(scale: float) -> tuple[FloatArray, _Check]:
         v = base
         if scale != 1.0:
             v = _same_strength(blend, scale * modes, base, speed_range or MEASURED_SPEEDS)
             v = _printable_speeds(v, speed_range or MEASURED_SPEEDS, speed_resolution)
-        checked = _verify(blend, np.concatenate([modes, v]), seed, target, picked, size, lattice)
+        # scaled designs warm-started from the base design's fresh equilibrium
+        near.last = None if scale == 1.0 else (base_p, tried[1.0][1].result.state)
+        p_s = np.concatenate([modes, v])
+        checked = _verify(blend, p_s, seed, target, picked, size, lattice, near)
         eq.solves += checked.solves
         return v, checked
 
-    tried = {1.0: check_scale(1.0)}
+    base_p = np.concatenate([modes, base])
+    tried: dict[float, tuple[FloatArray, _Check]] = {}
+    tried[1.0] = check_scale(1.0)
     if speed_range is not None and target.gaussian_curvature is not None:
         # (5) the overall bending strength scaled about the optimum (every edge's mismatch
         # times s): the misfit is flat in this direction near its optimum, the target's K is
@@ -809,6 +845,12 @@ def design_lattice(
                 tried.setdefault(scale, check_scale(scale))
             step /= 2
     speeds, check = min(tried.values(), key=lambda t: t[1].rank)
+    if check is not tried[1.0][1]:
+        # the chosen scale verified as the forward simulation runs it: a fresh ramp (kept only
+        # if it is still better than the fresh base design)
+        fresh = _verify(blend, np.concatenate([modes, speeds]), seed, target, picked, size, lattice)
+        eq.solves += fresh.solves
+        speeds, check = min([(speeds, fresh), tried[1.0]], key=lambda t: t[1].rank)
     final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
     rms = float(np.sqrt(2.0 * j)) * size
     printed = with_settings(lattice, modes, speeds if speed_range is not None else None)

@@ -214,9 +214,7 @@ def run_inverse(
         "(not given by the paper)",
         "target_gaussian_curvature": k_t,
         "achieved_gaussian_curvature": k_a,
-        "gaussian_curvature_error_rel": None
-        if k_t is None
-        else abs(abs(k_a) - abs(k_t)) / abs(k_t),
+        "gaussian_curvature_error_rel": None if k_t is None else abs(k_a - k_t) / abs(k_t),
         "misfit_rms_mm": des.misfit_rms,
         "misfit_rel": des.misfit_rel,
         "stable": des.stable,
