@@ -171,3 +171,31 @@ def test_rod_pressed_on_a_cylinder_obstacle_feels_the_load():
     )
     (force,) = res.contact.obstacle_forces(res.positions)
     assert -force[2] == pytest.approx(2.0 * closing, rel=0.02)
+
+
+def test_free_filament_rests_on_two_cylinders_under_its_weight():
+    """A free filament (no support) across two fixed parallel rods carries its buoyant weight on
+    them: spheres and cylinders hold a free body where it touches, so no rigid motion is
+    projected out of its steps (a frictionless floor alone leaves three). Lying square across
+    the rods is a saddle (turning about the vertical lengthens the span, and the sag lowers the
+    weight): the solver leaves it and the filament comes to rest turned, still certified."""
+    x = np.linspace(-5.0, 5.0, 21)
+    pts = np.stack([x, 0 * x, np.full_like(x, 2.1 * R)], 1)
+    EI = E * np.pi * R**4 / 4
+    model = Model.chain(
+        pts, bending_stiffness1=EI, bending_stiffness2=EI, twist_stiffness=EI / 1.5,
+        axial_stiffness=E * np.pi * R**2,
+    )  # fmt: skip
+    rods = tuple(Cylinder.along((a, 0.0, 0.0), (0.0, 1.0, 0.0), radius=R) for a in (-3.0, 3.0))
+    gravity = Gravity(density=1.2, area=np.pi * R**2, fluid_density=0.97)
+    res = solve_static(model, loads=Loads(gravity=gravity), contact=Contact(R, rods))
+    assert res.stable and res.escapes >= 1
+    weight = float((gravity.line_weight(20) * np.diff(x)).sum())
+    left, right = res.contact.obstacle_forces(res.positions)
+    assert -(left + right)[2] == pytest.approx(weight, rel=1e-6)
+    # moments about the centre of weight balance (the sliding position along the rods is
+    # nearly neutral, so the split between the rods follows where it came to rest)
+    w = np.r_[0.5, np.ones(19), 0.5]
+    centre = float(w @ res.positions[:, 0] / w.sum())
+    moment = left[2] * (-3.0 - centre) + right[2] * (3.0 - centre)
+    assert abs(moment) < 1e-3 * weight * 3.0

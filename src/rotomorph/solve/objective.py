@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
+from rotomorph.contact.obstacles import Floor
 from rotomorph.contact.potential import Contact, InfeasibleContactError
 from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.assembly import (
@@ -102,13 +103,13 @@ class RodObjective:
         self._moment_edges, self._moments = self._edge_moments(loads)
         if (
             supports.is_free
-            and (contact is None or contact.floor is None)
+            and (contact is None or not contact.obstacles)
             and np.linalg.norm(self._external[self._pos_index].reshape(-1, 3).sum(0)) > 0
         ):
             raise InvalidParameterError(
                 "Supports",
                 "a free body under a net external force has no equilibrium; "
-                "pin or clamp at least one node",
+                "pin or clamp at least one node, or give it obstacles to rest on (contact)",
             )
         # work buffers
         self._grad = np.zeros(lay.count)
@@ -123,15 +124,18 @@ class RodObjective:
         self._fixed_mask = fixed
         self._contact: ContactTerm | None = None
         self._contact_hess = None
-        # a frictionless floor leaves a free body its in-plane rigid motions (projected out)
-        self._floor_normal = (
-            None
-            if contact is None or contact.floor is None or contact.friction > 0
-            else contact.floor
+        # with friction the floor holds a free body in every direction wherever it touches, and
+        # spheres and cylinders hold it in directions that depend on where it touches them: no
+        # rigid motion is projected out (one that stays free has zero energy and is handled by
+        # the shift, like any singular direction)
+        self._held = contact is not None and (
+            (contact.floor is not None and contact.friction > 0)
+            or any(not isinstance(o, Floor) for o in contact.obstacles)
         )
-        # with friction the floor holds a free body in every direction wherever it touches:
-        # no rigid motion is free
-        self._held = contact is not None and contact.floor is not None and contact.friction > 0
+        # a frictionless floor alone leaves a free body its in-plane rigid motions (projected)
+        self._floor_normal = (
+            None if contact is None or contact.floor is None or self._held else contact.floor
+        )
         self.set_base(state)
         self._setup_scales(loads)
         if contact is not None:
