@@ -112,13 +112,15 @@ def _on_surface(design: LatticeDesign, target: SurfaceTarget, folder: Path) -> P
         ax.plot(*y[[a, b]].T, color="k", lw=0.8)
     _equal_3d(ax, y)
     ax.set_title(f"{design.target.description}: designed lattice (lines) on the target")
-    ax2 = fig.add_subplot(1, 3, 3)
+    ax2 = fig.add_subplot(1, 2, 2)
     lim = max(float(np.max(np.abs(err))), 0.01 * size)
     sc = ax2.scatter(y[:, 0], y[:, 1], c=err, cmap="RdBu_r", vmin=-lim, vmax=lim, s=6)
     ax2.set_aspect("equal")
     ax2.set_xlabel("x (mm)")
     ax2.set_ylabel("y (mm)")
-    ax2.set_title(f"height error (mm), RMS {design.misfit_rms:.3g} mm")
+    ax2.set_title(
+        f"height error of every node (mm)\nRMS at the compared nodes {design.misfit_rms:.3g} mm"
+    )
     fig.colorbar(sc, ax=ax2, shrink=0.8)
     fig.tight_layout()
     return save_figure(fig, folder / "target_vs_achieved.png")
