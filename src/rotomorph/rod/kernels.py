@@ -232,30 +232,35 @@ def bend_twist_stencil(
             )
     if need_hess == 2:
         return energy, kappa1, kappa2
+    # indices and flags as plain (non-literal) values: numba compiles a helper once per literal
+    # argument value otherwise (13 compiled specialisations of 5 helpers instead of 5)
+    i0, i1, i2 = np.int64(0), np.int64(1), np.int64(2)
+    col_e, col_f = np.int64(3), np.int64(7)
+    sym, plain = np.bool_(True), np.bool_(False)
     ne2 = ne * ne
     nf2 = nf * nf
     nef = ne * nf
     # ---- kappa1 second derivatives (Jawed, Novelia & O'Reilly 2018, Sec. 7) ----
     if a1 != 0.0:
-        _clear(D, 0)
-        _clear(D, 1)
-        _clear(D, 2)
-        _outer(D, 0, 2.0 * kappa1 / ne2, tt, tt, False)
-        _outer(D, 0, -1.0 / ne2, tf_d2, tt, True)
-        _identity(D, 0, -kappa1 / (chi * ne2))
-        _outer(D, 0, kappa1 / (chi * ne2), te, te, False)
-        _outer(D, 0, 0.25 / ne2, kb, m2e, True)
-        _outer(D, 1, 2.0 * kappa1 / nf2, tt, tt, False)
-        _outer(D, 1, 1.0 / nf2, te_d2, tt, True)
-        _identity(D, 1, -kappa1 / (chi * nf2))
-        _outer(D, 1, kappa1 / (chi * nf2), tf, tf, False)
-        _outer(D, 1, 0.25 / nf2, kb, m2f, True)
-        _identity(D, 2, -kappa1 / (chi * nef))
-        _outer(D, 2, -kappa1 / (chi * nef), te, tf, False)
-        _outer(D, 2, 2.0 * kappa1 / nef, tt, tt, False)
-        _outer(D, 2, -1.0 / nef, tf_d2, tt, False)
-        _outer(D, 2, 1.0 / nef, tt, te_d2, False)
-        _cross_matrix(D, 2, -1.0 / nef, d2t)
+        _clear(D, i0)
+        _clear(D, i1)
+        _clear(D, i2)
+        _outer(D, i0, 2.0 * kappa1 / ne2, tt, tt, plain)
+        _outer(D, i0, -1.0 / ne2, tf_d2, tt, sym)
+        _identity(D, i0, -kappa1 / (chi * ne2))
+        _outer(D, i0, kappa1 / (chi * ne2), te, te, plain)
+        _outer(D, i0, 0.25 / ne2, kb, m2e, sym)
+        _outer(D, i1, 2.0 * kappa1 / nf2, tt, tt, plain)
+        _outer(D, i1, 1.0 / nf2, te_d2, tt, sym)
+        _identity(D, i1, -kappa1 / (chi * nf2))
+        _outer(D, i1, kappa1 / (chi * nf2), tf, tf, plain)
+        _outer(D, i1, 0.25 / nf2, kb, m2f, sym)
+        _identity(D, i2, -kappa1 / (chi * nef))
+        _outer(D, i2, -kappa1 / (chi * nef), te, tf, plain)
+        _outer(D, i2, 2.0 * kappa1 / nef, tt, tt, plain)
+        _outer(D, i2, -1.0 / nef, tf_d2, tt, plain)
+        _outer(D, i2, 1.0 / nef, tt, te_d2, plain)
+        _cross_matrix(D, i2, -1.0 / nef, d2t)
         _place_edge_blocks(hess, a1, D)
         hess[3, 3] += a1 * (-0.5 * _dot(kb, m2e))
         hess[7, 7] += a1 * (-0.5 * _dot(kb, m2f))
@@ -263,7 +268,7 @@ def bend_twist_stencil(
         _place_theta(
             hess,
             a1,
-            3,
+            col_e,
             _lin(c / ne, tt, -ic / ne, _cross(tf, m1e)),
             _lin(c / nf, tt, ic / nf, _cross(te, m1e)),
         )
@@ -271,31 +276,31 @@ def bend_twist_stencil(
         _place_theta(
             hess,
             a1,
-            7,
+            col_f,
             _lin(c / ne, tt, -ic / ne, _cross(tf, m1f)),
             _lin(c / nf, tt, ic / nf, _cross(te, m1f)),
         )
     # ---- kappa2 second derivatives ----
     if a2 != 0.0:
-        _clear(D, 0)
-        _clear(D, 1)
-        _clear(D, 2)
-        _outer(D, 0, 2.0 * kappa2 / ne2, tt, tt, False)
-        _outer(D, 0, 1.0 / ne2, tf_d1, tt, True)
-        _identity(D, 0, -kappa2 / (chi * ne2))
-        _outer(D, 0, kappa2 / (chi * ne2), te, te, False)
-        _outer(D, 0, -0.25 / ne2, kb, m1e, True)
-        _outer(D, 1, 2.0 * kappa2 / nf2, tt, tt, False)
-        _outer(D, 1, -1.0 / nf2, te_d1, tt, True)
-        _identity(D, 1, -kappa2 / (chi * nf2))
-        _outer(D, 1, kappa2 / (chi * nf2), tf, tf, False)
-        _outer(D, 1, -0.25 / nf2, kb, m1f, True)
-        _identity(D, 2, -kappa2 / (chi * nef))
-        _outer(D, 2, -kappa2 / (chi * nef), te, tf, False)
-        _outer(D, 2, 2.0 * kappa2 / nef, tt, tt, False)
-        _outer(D, 2, 1.0 / nef, tf_d1, tt, False)
-        _outer(D, 2, -1.0 / nef, tt, te_d1, False)
-        _cross_matrix(D, 2, 1.0 / nef, d1t)
+        _clear(D, i0)
+        _clear(D, i1)
+        _clear(D, i2)
+        _outer(D, i0, 2.0 * kappa2 / ne2, tt, tt, plain)
+        _outer(D, i0, 1.0 / ne2, tf_d1, tt, sym)
+        _identity(D, i0, -kappa2 / (chi * ne2))
+        _outer(D, i0, kappa2 / (chi * ne2), te, te, plain)
+        _outer(D, i0, -0.25 / ne2, kb, m1e, sym)
+        _outer(D, i1, 2.0 * kappa2 / nf2, tt, tt, plain)
+        _outer(D, i1, -1.0 / nf2, te_d1, tt, sym)
+        _identity(D, i1, -kappa2 / (chi * nf2))
+        _outer(D, i1, kappa2 / (chi * nf2), tf, tf, plain)
+        _outer(D, i1, -0.25 / nf2, kb, m1f, sym)
+        _identity(D, i2, -kappa2 / (chi * nef))
+        _outer(D, i2, -kappa2 / (chi * nef), te, tf, plain)
+        _outer(D, i2, 2.0 * kappa2 / nef, tt, tt, plain)
+        _outer(D, i2, 1.0 / nef, tf_d1, tt, plain)
+        _outer(D, i2, -1.0 / nef, tt, te_d1, plain)
+        _cross_matrix(D, i2, 1.0 / nef, d1t)
         _place_edge_blocks(hess, a2, D)
         hess[3, 3] += a2 * (0.5 * _dot(kb, m1e))
         hess[7, 7] += a2 * (0.5 * _dot(kb, m1f))
@@ -303,7 +308,7 @@ def bend_twist_stencil(
         _place_theta(
             hess,
             a2,
-            3,
+            col_e,
             _lin(c / ne, tt, -ic / ne, _cross(tf, m2e)),
             _lin(c / nf, tt, ic / nf, _cross(te, m2e)),
         )
@@ -311,19 +316,19 @@ def bend_twist_stencil(
         _place_theta(
             hess,
             a2,
-            7,
+            col_f,
             _lin(c / ne, tt, -ic / ne, _cross(tf, m2f)),
             _lin(c / nf, tt, ic / nf, _cross(te, m2f)),
         )
     # ---- twist (reference twist) second derivatives ----
     if a3 != 0.0:
-        _clear(D, 0)
-        _clear(D, 1)
-        _clear(D, 2)
-        _outer(D, 0, -0.25 / ne2, kb, _lin(1.0, te, 1.0, tt), True)
-        _outer(D, 1, -0.25 / nf2, kb, _lin(1.0, tf, 1.0, tt), True)
-        _cross_matrix(D, 2, 1.0 / (chi * nef), te)
-        _outer(D, 2, -0.5 / nef, kb, tt, False)
+        _clear(D, i0)
+        _clear(D, i1)
+        _clear(D, i2)
+        _outer(D, i0, -0.25 / ne2, kb, _lin(1.0, te, 1.0, tt), sym)
+        _outer(D, i1, -0.25 / nf2, kb, _lin(1.0, tf, 1.0, tt), sym)
+        _cross_matrix(D, i2, 1.0 / (chi * nef), te)
+        _outer(D, i2, -0.5 / nef, kb, tt, plain)
         _place_edge_blocks(hess, a3, D)
     # The blocks are placed symmetrically (d2/de df and its transpose), so ``hess`` is the
     # symmetric part of the Jacobian of the gradient: the exact Hessian with re-based frames.

@@ -37,18 +37,23 @@ from rotomorph.errors import InvalidDesignError
 __all__ = ["free_equilibrium", "min_clearance"]
 
 
+# Scalar code on purpose: array expressions and row assignments (``out[i] = v``) make numba
+# compile shape checks with formatted error messages, which cost ~10 s of compilation on the
+# first run; component-wise code does the same arithmetic in the same order and compiles in ~1 s.
+
+
 @numba.njit(cache=True)
-def _rotate(v: FloatArray, axis: FloatArray, angle: float) -> FloatArray:  # pragma: no cover
-    """Rotate ``v`` about the unit ``axis`` by ``angle`` (Rodrigues)."""
+def _rotate(
+    v0: float, v1: float, v2: float, a0: float, a1: float, a2: float, angle: float
+) -> tuple[float, float, float]:  # pragma: no cover - compiled
+    """Rotate ``v`` about the unit axis ``a`` by ``angle`` (Rodrigues)."""
     c, s = np.cos(angle), np.sin(angle)
-    cr = np.array(
-        [
-            axis[1] * v[2] - axis[2] * v[1],
-            axis[2] * v[0] - axis[0] * v[2],
-            axis[0] * v[1] - axis[1] * v[0],
-        ]
+    d, e = a0 * v0 + a1 * v1 + a2 * v2, 1.0 - c
+    return (
+        v0 * c + (a1 * v2 - a2 * v1) * s + a0 * d * e,
+        v1 * c + (a2 * v0 - a0 * v2) * s + a1 * d * e,
+        v2 * c + (a0 * v1 - a1 * v0) * s + a2 * d * e,
     )
-    return v * c + cr * s + axis * (axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2]) * (1.0 - c)
 
 
 @numba.njit(cache=True)
@@ -63,30 +68,36 @@ def _build(
 ) -> FloatArray:  # pragma: no cover - compiled
     n = len(rest) + 1
     out = np.empty((n, 3))
-    out[0] = start
-    out[1] = start + rest[0] * t
+    t0, t1, t2 = t[0], t[1], t[2]
+    p0, p1, p2 = m1[0], m1[1], m1[2]
+    for k in range(3):
+        out[0, k] = start[k]
+        out[1, k] = start[k] + rest[0] * t[k]
     for i in range(n - 2):
-        m2 = np.array(
-            [t[1] * m1[2] - t[2] * m1[1], t[2] * m1[0] - t[0] * m1[2], t[0] * m1[1] - t[1] * m1[0]]
-        )
+        q0, q1, q2 = t1 * p2 - t2 * p1, t2 * p0 - t0 * p2, t0 * p1 - t1 * p0  # m2 = t x m1
         c, s = np.cos(tw[i]), np.sin(tw[i])
         # [[-s, 1 + c], [-(1 + c), -s]] a = 2 (k1, k2); determinant 2 + 2c
         det = s * s + (1.0 + c) * (1.0 + c)
         b1, b2 = 2.0 * k1[i], 2.0 * k2[i]
         a1 = (-s * b1 - (1.0 + c) * b2) / det
         a2 = ((1.0 + c) * b1 - s * b2) / det
-        kb = a1 * m1 + a2 * m2
-        size = np.sqrt(kb[0] ** 2 + kb[1] ** 2 + kb[2] ** 2)
+        kb0, kb1, kb2 = a1 * p0 + a2 * q0, a1 * p1 + a2 * q1, a1 * p2 + a2 * q2
+        size = np.sqrt(kb0**2 + kb1**2 + kb2**2)
         if size > 0.0:
-            axis = kb / size
+            x0, x1, x2 = kb0 / size, kb1 / size, kb2 / size
             beta = 2.0 * np.arctan(0.5 * size)
-            t = _rotate(t, axis, beta)
-            m1 = _rotate(m1, axis, beta)
-        m1 = _rotate(m1, t, tw[i])
-        t = t / np.sqrt(t[0] ** 2 + t[1] ** 2 + t[2] ** 2)
-        m1 = m1 - (m1[0] * t[0] + m1[1] * t[1] + m1[2] * t[2]) * t
-        m1 = m1 / np.sqrt(m1[0] ** 2 + m1[1] ** 2 + m1[2] ** 2)
-        out[i + 2] = out[i + 1] + rest[i + 1] * t
+            t0, t1, t2 = _rotate(t0, t1, t2, x0, x1, x2, beta)
+            p0, p1, p2 = _rotate(p0, p1, p2, x0, x1, x2, beta)
+        p0, p1, p2 = _rotate(p0, p1, p2, t0, t1, t2, tw[i])
+        norm = np.sqrt(t0**2 + t1**2 + t2**2)
+        t0, t1, t2 = t0 / norm, t1 / norm, t2 / norm
+        d = p0 * t0 + p1 * t1 + p2 * t2
+        p0, p1, p2 = p0 - d * t0, p1 - d * t1, p2 - d * t2
+        norm = np.sqrt(p0**2 + p1**2 + p2**2)
+        p0, p1, p2 = p0 / norm, p1 / norm, p2 / norm
+        out[i + 2, 0] = out[i + 1, 0] + rest[i + 1] * t0
+        out[i + 2, 1] = out[i + 1, 1] + rest[i + 1] * t1
+        out[i + 2, 2] = out[i + 1, 2] + rest[i + 1] * t2
     return out
 
 
