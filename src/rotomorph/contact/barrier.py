@@ -40,14 +40,23 @@ def barrier(z, zhat):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _psd_project(h):  # pragma: no cover - compiled
+def _psd_project(h, out):  # pragma: no cover - compiled
+    """``out`` = ``h`` with its negative eigenvalues dropped (``out`` may be ``h`` itself).
+
+    Loops, not ``out += vals[k] * np.outer(v, v)`` into a returned array: array expressions and
+    row assignments make numba compile shape checks with formatted messages (~5 s on the first
+    run); the arithmetic is the same, in the same order.
+    """
     vals, vecs = np.linalg.eigh(h)
-    out = np.zeros_like(h)
-    for k in range(vals.shape[0]):
+    n = vals.shape[0]
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 0.0
+    for k in range(n):
         if vals[k] > 0.0:
-            v = vecs[:, k]
-            out += vals[k] * np.outer(v, v)
-    return out
+            for i in range(n):
+                for j in range(n):
+                    out[i, j] += vals[k] * (vecs[i, k] * vecs[j, k])
 
 
 @njit(cache=True)
@@ -112,6 +121,7 @@ def pair_barrier(
     any pair touches.
     """
     energy = 0.0
+    no, yes = np.bool_(False), np.bool_(True)  # not literals: one compiled segment_distance2
     g = np.empty(12)
     h = np.empty((12, 12))
     gx = np.empty(12)
@@ -122,7 +132,7 @@ def pair_barrier(
         dist[p] = np.sqrt(D)
         if D >= (dmin[p] + dhat) * (dmin[p] + dhat):
             continue  # inactive: zero energy, its hloc block is left unwritten
-        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], False, g, h)
+        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], no, g, h)
         zhat = (2.0 * dmin[p] + dhat) * dhat
         b, b1, b2 = barrier(D - dmin[p] * dmin[p], zhat)
         if b == 0.0 and b1 == 0.0:
@@ -132,7 +142,7 @@ def pair_barrier(
         if not np.isfinite(b):
             return np.inf
         if need_hess:  # active pair: now its Hessian
-            segment_distance2(x[i0], x[i1], x[j0], x[j1], True, g, h)
+            segment_distance2(x[i0], x[i1], x[j0], x[j1], yes, g, h)
         m, m1, m2 = 1.0, 0.0, 0.0
         if mollify[p] > 0.0:
             cx = cross_norm2(x[i0], x[i1], x[j0], x[j1], need_hess > 0, gx, hx)
@@ -157,7 +167,7 @@ def pair_barrier(
                         v += b * (m2 * gx[i] * gx[j] + m1 * hx[i, j])
                     hloc[p, i, j] = c * v
             if need_hess == 2:
-                hloc[p] = _psd_project(hloc[p])
+                _psd_project(hloc[p], hloc[p])
     return energy
 
 

@@ -40,7 +40,9 @@ def _grow(buf, count):  # pragma: no cover - compiled
     if count < buf.shape[0]:
         return buf
     out = np.empty((2 * buf.shape[0], 2), dtype=np.int64)
-    out[:count] = buf[:count]
+    for r in range(count):  # a loop: a slice copy compiles shape checks with messages (~5 s)
+        out[r, 0] = buf[r, 0]
+        out[r, 1] = buf[r, 1]
     return out
 
 
@@ -74,8 +76,8 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
     order = np.argsort(start)
     seg = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
     node = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
-    ns = 0
-    nq = 0
+    ns = np.int64(0)  # not the literal 0: one compiled _grow, not one per literal
+    nq = np.int64(0)
     for ii in range(m):
         i = order[ii]
         end = hi[i, axis] + share[i]

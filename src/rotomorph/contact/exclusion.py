@@ -101,7 +101,8 @@ def excluded_pairs(
     fused = np.zeros((0, 2), dtype=np.int64)
     if len(cand):
         quads = np.ascontiguousarray(np.concatenate([edges[cand[:, 0]], edges[cand[:, 1]]], 1))
-        d = pair_distances(np.ascontiguousarray(nodes, dtype=float), quads)
+        # a writable copy: a read-only array is another type to numba (a second compilation)
+        d = pair_distances(np.array(nodes, dtype=float), quads)
         limit = radius[cand[:, 0]] + radius[cand[:, 1]] + activation
         fused = cand[d < limit]
     return pair_keys(np.concatenate([near, fused]), len(edges))
