@@ -95,11 +95,33 @@ def _phases() -> Iterator[None]:
         log.propagate = old[1]
 
 
+#: Commands that run compiled kernels (they say so at once when the kernel cache is cold).
+_COMPILING = ("simulate", "paper")
+
+
+def _announce_compiling(args: argparse.Namespace) -> None:
+    """Before a compiling command imports anything heavy (about a second after start): say
+    "compiling kernels (first run only)" when the kernel cache is cold; remember the answer
+    on ``args`` for :func:`_compiling_note`."""
+    args.kernels_cold = False
+    if args.command not in _COMPILING or not _show_progress():
+        return
+    from rotomorph.simulate.kernel_cache import kernels_cached
+
+    if not kernels_cached():
+        args.kernels_cold = True
+        sys.stderr.write(
+            "rotomorph: compiling kernels (first run only; about 20-40 s of CPU, cached after)\n"
+        )
+        sys.stderr.flush()
+
+
 @contextlib.contextmanager
-def _compiling_note() -> Iterator[None]:
-    """Say "compiling kernels (first run only)" at once when the kernel cache is cold, with a
-    bar of compiled kernels (a watcher thread) until they are all loaded or the command ends."""
-    if not _show_progress():
+def _compiling_note(args: argparse.Namespace) -> Iterator[None]:
+    """While a command runs on a cold kernel cache (:func:`_announce_compiling`): a bar of
+    compiled kernels on a terminal, a line every 10 s in a log, until the core kernels are
+    cached or the command ends."""
+    if not getattr(args, "kernels_cold", False) or not _show_progress():
         yield
         return
     import threading
@@ -107,35 +129,34 @@ def _compiling_note() -> Iterator[None]:
 
     from rotomorph.simulate.kernel_cache import compiled_count, dispatchers, kernels_cached
 
-    if kernels_cached():
-        yield
-        return
-    sys.stderr.write(
-        "rotomorph: compiling kernels (first run only; about 1 min on 2 cores, cached after)\n"
-    )
     done = threading.Event()
     t0 = time.perf_counter()
+    log = logging.getLogger("rotomorph.progress")
 
     def watch() -> None:
         from tqdm import tqdm
 
         total = len(dispatchers())
-        with tqdm(total=total, desc="compiling kernels", unit="kernel", leave=False) as bar:
+        tty = sys.stderr.isatty()  # a live bar only on a terminal (no \r in logs)
+        with tqdm(
+            total=total, desc="compiling kernels", unit="kernel", leave=False, disable=not tty
+        ) as bar:
+            next_line = 10.0
             while not done.wait(0.5) and kernels_cached() is False:
                 bar.update(compiled_count() - bar.n)
+                if not tty and time.perf_counter() - t0 >= next_line:
+                    log.info("compiling kernels: %d of %d ready", compiled_count(), total)
+                    next_line += 10.0
 
     thread = threading.Thread(target=watch, daemon=True)
-    if sys.stderr.isatty():  # a live bar only on a terminal (no \r in logs)
-        thread.start()
+    thread.start()
     try:
         yield
     finally:
         done.set()
         if thread.is_alive():
             thread.join(timeout=2)
-        logging.getLogger("rotomorph.progress").info(
-            "kernels ready after %.0f s", time.perf_counter() - t0
-        )
+        log.info("kernels ready after %.0f s", time.perf_counter() - t0)
 
 
 def _existing_file(path: str, what: str) -> Path:
@@ -314,7 +335,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     except InvalidParameterError as err:
         flag = "--" + err.field.replace("_", "-")
         raise UsageError(f"{flag}: {str(err).split(': ', 1)[1]}") from None
-    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note():
+    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note(args):
         with _progress(step_count(design, args.steps), "simulate") as bar:
             sim = simulate_design(
                 design,
@@ -326,7 +347,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                 model=options["model"],
                 progress=bar.update,
             )
-        logging.getLogger("rotomorph.progress").info("writing results, figures and movie")
+        logging.getLogger("rotomorph.progress").info("describing the run (frames, twist, flags)")
         results = describe_run(sim)
         write_run_results(results, tmp, movie=not args.no_movie)
     _print(f"wrote {args.output}: {run_line(results)}")
@@ -383,7 +404,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 def _cmd_paper(args: argparse.Namespace) -> int:
     from rotomorph.simulate.report import paper_report
 
-    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note():
+    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note(args):
         with _progress(0, "paper") as bar:
 
             def progress(done: int, total: int) -> None:
@@ -597,6 +618,7 @@ def _main(argv: Sequence[str] | None) -> int:
             level=logging.INFO if args.verbose else logging.WARNING,
             format="rotomorph: %(levelname)s: %(message)s",
         )
+        _announce_compiling(args)
         return int(args.func(args))
     except SystemExit as exc:  # --help, --version
         return int(exc.code or 0) if isinstance(exc.code, int) else EXIT_OK

@@ -21,18 +21,28 @@ KERNEL_MODULES: Final = (
     "rotomorph.geometry",
     "rotomorph.rod.kernels",
     "rotomorph.rod.assembly",
+    "rotomorph.rod.sensitivity",
     "rotomorph.solve.banded",
+    "rotomorph.solve.linalg",
     "rotomorph.solve.sparse_cholesky",
     "rotomorph.solve.retraction",
+    "rotomorph.contact.barrier",
+    "rotomorph.contact.broadphase",
+    "rotomorph.contact.ccd",
+    "rotomorph.contact.distance",
+    "rotomorph.simulate.free_shape",
 )
 
+#: Modules of :data:`CORE_KERNELS` (imported to read their cache index: numba and two modules).
+_CORE_MODULES: Final = ("rotomorph.rod.kernels", "rotomorph.rod.assembly")
 
-def dispatchers() -> list[Any]:
-    """The top-level numba dispatchers of :data:`KERNEL_MODULES` (inlined helpers excluded)."""
+
+def dispatchers(modules: tuple[str, ...] = KERNEL_MODULES) -> list[Any]:
+    """The top-level numba dispatchers of ``modules`` (inlined helpers excluded)."""
     from numba.core.registry import CPUDispatcher
 
     out = []
-    for name in KERNEL_MODULES:
+    for name in modules:
         module = importlib.import_module(name)
         for value in vars(module).values():
             if (
@@ -56,7 +66,7 @@ def kernels_cached() -> bool:
     compile in a second or two when first needed.
     """
     try:
-        for disp in dispatchers():
+        for disp in dispatchers(_CORE_MODULES):
             if disp.py_func.__name__ not in CORE_KERNELS:
                 continue
             cache = getattr(disp, "_cache", None)

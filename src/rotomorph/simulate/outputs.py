@@ -28,6 +28,7 @@ States that are not physical are flagged in every figure title (:mod:`rotomorph.
 
 from __future__ import annotations
 
+import logging
 import os
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,9 @@ import numpy as np
 from rotomorph.io.results import RunResults, summarize, write_results, write_summary
 from rotomorph.io.validity import StepVerdict, assess, run_verdict
 from rotomorph.io.vtk import network_lines, write_vtp_series, write_vtu_series
+
+#: Phase messages of the writing steps (a command line shows them; silent by default).
+phase_log = logging.getLogger("rotomorph.progress")
 
 __all__ = [
     "colour_field",
@@ -575,6 +579,7 @@ def write_run_results(
     into ``folder`` (created if missing); return the paths."""
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
+    phase_log.info("writing: results.h5 and summary.json")
     paths = [
         write_results(
             out / "results.h5",
@@ -591,6 +596,8 @@ def write_run_results(
         )
     ]
     paths.append(write_summary(out / "summary.json", summarize(results)))
+    phase_log.info("writing: figures%s", " and movie" if movie else "")
     paths += plot_run(results, out / "figures", movie=movie)
+    phase_log.info("writing: ParaView files")
     paths += write_vtk(results, out / "paraview")
     return paths
