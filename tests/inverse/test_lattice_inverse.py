@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rotomorph.contact import Contact
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.errors import InvalidDesignError, InvalidParameterError
-from rotomorph.inverse.adjoint import richardson_difference
+from rotomorph.inverse.adjoint import NotAMinimumError, richardson_difference
 from rotomorph.inverse.blend import with_settings
 from rotomorph.inverse.lattice import (
     SOLVE_OPTIONS,
+    Surroundings,
     _Equilibria,
     design_lattice,
     dome,
@@ -21,8 +23,10 @@ from rotomorph.inverse.lattice import (
     shape,
     shape_misfit,
     surface_misfit,
+    surroundings,
 )
 from rotomorph.inverse.run import lattice_design_file
+from rotomorph.lattice.heating import lattice_gravity
 from rotomorph.solve.newton import NewtonOptions
 
 
@@ -61,6 +65,51 @@ def test_adjoint_gradient_matches_central_differences(small):
         for e in (0, 9, n + 1, n + 8):
             fd = richardson_difference(lambda h, e=e: shifted(e, h), 1e-3)
             assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
+
+
+def test_adjoint_gradient_with_active_contact_matches_central_differences(small):
+    """A lattice resting on the floor under its buoyant weight: the barrier's Hessian is part
+    of the adjoint system (without it the rod Hessian alone is not that of a minimum) and the
+    weight's dependence on the rest lengths part of dg/dp; both checked against
+    Richardson-extrapolated central differences of tightly solved perturbed equilibria."""
+    lat, blend = small
+    env = surroundings(blend, contact=True, floor=True, gravity=lattice_gravity(lat))
+    assert env.contact is not None and env.contact.stiffness is not None  # fixed barrier
+    eq = _Equilibria(blend, env=env)
+    rng = np.random.default_rng(3)
+    base = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
+    c = np.clip(0.7 * base + rng.uniform(-0.1, 0.1, blend.n_edges), -1, 1)
+    p = np.concatenate([c, rng.uniform(1.0, 2.5, blend.n_edges)])
+    res = eq(p)
+    assert res.contact.active_contacts(res.positions) > 0  # it rests on the floor
+    target = dome(0.04)
+    j, g = misfit_and_gradient(blend, p, res, target, 10.0, env=env)
+    with pytest.raises(NotAMinimumError):  # the rod Hessian without the barrier's
+        misfit_and_gradient(blend, p, res, target, 10.0)
+    # the same barrier, the weight's rest-length term left out
+    _, g_no_weight = misfit_and_gradient(blend, p, res, target, 10.0, env=Surroundings(env.contact))
+    eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
+
+    def shifted(e, h):
+        pp = p.copy()
+        pp[e] += h
+        eq.last = (p, res.state)
+        return surface_misfit(eq(pp).positions, target, 10.0)[0]
+
+    n = blend.n_edges
+    for e in (0, 9, n + 1, n + 8):
+        fd = richardson_difference(lambda h, e=e: shifted(e, h), 1e-3)
+        assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
+        if e >= n:  # speeds change the rest lengths, hence the weight
+            assert abs(g_no_weight[e] - fd) > 10 * 1e-5 * abs(fd)
+
+
+def test_contact_settings_are_checked(small):
+    lat, blend = small
+    with pytest.raises(InvalidParameterError, match="gravity"):
+        surroundings(blend, gravity=lattice_gravity(lat))
+    with pytest.raises(InvalidParameterError, match="friction"):
+        surroundings(blend, contact=Contact(radius=lat.radius, friction=0.3))
 
 
 def test_design_is_printable_verified_and_written_as_a_design_file(tmp_path):

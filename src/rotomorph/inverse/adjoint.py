@@ -24,6 +24,17 @@ iteratively against :math:`H` itself, which removes the bias the shift would oth
 along soft modes (relative :math:`\delta/\mu` on an eigenvalue :math:`\mu`). The same
 factorisation certifies that the equilibrium is a minimum (it fails when :math:`H` has a
 negative eigenvalue).
+
+Contact (:class:`~rotomorph.contact.Contact`: self-contact and a floor) is part of ``g`` and
+``H``: the barrier's gradient and Hessian join the rod's at the equilibrium, as in the forward
+Newton solve. The barrier depends on the positions only, so it adds nothing to
+:math:`\partial g/\partial p` — provided its stiffness is fixed (give
+``Contact.stiffness``; the default is scaled from the natural values). Only frictionless
+contact is a conservative term: lagged friction is not a gradient and is refused. A free body
+on a frictionless floor keeps its three rigid motions along the floor, which ``H`` leaves
+singular and the shift handles as above. Gravity (a dead load per unit *rest* length) does
+depend on the rest lengths: its term :math:`-\tfrac12 w_j \hat d` on both nodes of edge
+:math:`j` enters :math:`\partial g/\partial l_j`.
 """
 
 from __future__ import annotations
@@ -36,6 +47,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rotomorph._typing import FloatArray
+from rotomorph.contact.potential import Contact
+from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.model import Model
 from rotomorph.rod.sensitivity import NaturalSensitivity, natural_sensitivity
 from rotomorph.rod.state import State
@@ -74,6 +87,7 @@ def adjoint(
     *,
     supports: Supports | None = None,
     loads: Loads | None = None,
+    contact: Contact | None = None,
     shift: float = 1e-10,
     refinements: int = 8,
 ) -> AdjointResult:
@@ -88,6 +102,9 @@ def adjoint(
         mm, twist angles in rad), in the layout's order.
     supports, loads
         As in the forward solve (fixed DOFs get a zero adjoint).
+    contact
+        As in the forward solve (frictionless; a fixed ``stiffness`` for exact gradients, see
+        the module docstring): the barrier's Hessian at ``state`` is part of ``H``.
     shift
         Relative shift of the metric added to ``H`` (module docstring).
     refinements
@@ -99,8 +116,15 @@ def adjoint(
     ------
     NotAMinimumError
         ``H + shift`` is not positive definite: the equilibrium is unstable.
+    InvalidParameterError
+        Contact with friction (not a conservative term).
     """
-    obj = RodObjective(model, state, supports or Supports(), loads or Loads())
+    if contact is not None and contact.friction > 0:
+        raise InvalidParameterError(
+            "Contact.friction", "the adjoint needs frictionless contact (friction=0)"
+        )
+    loads = loads or Loads()
+    obj = RodObjective(model, state, supports or Supports(), loads, contact)
     q = obj.vector()
     _, _, H = obj.evaluate(q, True, 1)
     H0 = _hessian_csc(H)
@@ -129,7 +153,23 @@ def adjoint(
         lam_free = lam_free + lu.solve(r)
     lam = np.zeros(model.layout.count)
     lam[obj.free] = lam_free
-    return AdjointResult(adjoint=lam, sensitivity=natural_sensitivity(model, state, lam))
+    sens = natural_sensitivity(model, state, lam)
+    if loads.gravity is not None:
+        sens.rest_length = sens.rest_length + _gravity_products(model, loads, lam)
+    return AdjointResult(adjoint=lam, sensitivity=sens)
+
+
+def _gravity_products(model: Model, loads: Loads, lam: FloatArray) -> FloatArray:
+    """``lambda^T dg/dl_j`` of the self-weight: each edge's weight ``w_j l_j`` (N) acts half
+    on each end node, so ``dg/dl_j = -w_j d / 2`` on both (``d`` the unit direction)."""
+    assert loads.gravity is not None
+    net, lay = model.network, model.layout
+    w = loads.gravity.line_weight(net.n_edges)
+    d = np.asarray(loads.gravity.direction, float)
+    d = d / np.linalg.norm(d)
+    lam_pos = lam[lay.pos[:, None] + np.arange(3)]  # (N, 3)
+    ends = lam_pos[net.edges[:, 0]] + lam_pos[net.edges[:, 1]]
+    return np.asarray(-0.5 * w * (ends @ d))
 
 
 def richardson_difference(fun: Callable[[float], float], step: float) -> float:

@@ -36,7 +36,7 @@ minimum is rejected by the line search (its objective is infinite).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -46,16 +46,19 @@ from scipy.spatial.transform import Rotation
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.curvature import fit_quadratic_surface
+from rotomorph.contact import Contact, Floor
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidDesignError, InvalidParameterError
 from rotomorph.inverse.adjoint import NotAMinimumError, adjoint
 from rotomorph.inverse.blend import LatticeBlend, lattice_blend, with_settings
 from rotomorph.lattice.actuation import Actuation
-from rotomorph.lattice.heating import perturbed_state, symmetry_breaking
+from rotomorph.lattice.heating import _contact_settings, perturbed_state, symmetry_breaking
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
 from rotomorph.solve.continuation import continuation
+from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.objective import RodObjective
 from rotomorph.solve.static import StaticResult, solve_static
 
 __all__ = [
@@ -64,6 +67,7 @@ __all__ = [
     "LatticeDesign",
     "ShapeTarget",
     "SurfaceTarget",
+    "Surroundings",
     "design_lattice",
     "dome",
     "height_map",
@@ -75,6 +79,7 @@ __all__ = [
     "shape_misfit",
     "split",
     "surface_misfit",
+    "surroundings",
 ]
 
 SOLVE_OPTIONS = NewtonOptions(rtol=1e-10, max_iterations=300)
@@ -306,10 +311,58 @@ def _misfit(
 
 
 # ---------------------------------------------------------------------------------- solve
-def _is_minimum(model: Model, state: State) -> bool:
+@dataclass(frozen=True, eq=False)
+class Surroundings:
+    """What the lattice rests in: frictionless contact (self-contact and/or a floor, with a
+    fixed barrier stiffness) and dead loads (buoyant self-weight). Default: neither."""
+
+    contact: Contact | None = None
+    loads: Loads | None = None
+
+
+def surroundings(
+    blend: LatticeBlend,
+    *,
+    contact: bool | Contact = False,
+    floor: bool | Floor = False,
+    gravity: Gravity | None = None,
+    seed: int = 0,
+) -> Surroundings:
+    """The forward solves' contact and loads, as :func:`rotomorph.lattice.heat_lattice`
+    builds them from the same arguments (a ``floor=True`` lies just below the perturbed
+    printed state), with the barrier stiffness fixed at its default for the printed lattice:
+    a default scaled from each design's natural values would make the barrier depend on the
+    design, which the adjoint gradient leaves out.
+
+    Raises
+    ------
+    InvalidParameterError
+        Contact with friction (not conservative: no adjoint gradient); gravity on a free
+        lattice without a floor to rest on.
+    """
+    lattice = blend.lattice
+    start = _Equilibria(blend, seed=seed)._flat(1.0)
+    settings = _contact_settings(lattice, start.positions, contact, floor, 0.0)
+    if settings is not None and settings.friction > 0:
+        raise InvalidParameterError(
+            "contact.friction", "inverse design needs frictionless contact (friction=0)"
+        )
+    if gravity is not None and (settings is None or settings.floor is None):
+        raise InvalidParameterError(
+            "gravity", "gravity on a free lattice needs a floor to rest on (floor=True)"
+        )
+    loads = None if gravity is None else Loads(gravity=gravity)
+    if settings is not None and settings.stiffness is None:
+        obj = RodObjective(blend.model, start, Supports(), loads or Loads(), settings)
+        settings = replace(settings, stiffness=float(obj.contact.kappa))
+    return Surroundings(settings, loads)
+
+
+def _is_minimum(model: Model, state: State, env: Surroundings | None = None) -> bool:
     """True when the equilibrium's Hessian (rigid modes aside) is positive semidefinite."""
+    env = env or Surroundings()
     try:
-        adjoint(model, state, np.zeros(model.layout.count))
+        adjoint(model, state, np.zeros(model.layout.count), loads=env.loads, contact=env.contact)
     except NotAMinimumError:
         return False
     return True
@@ -324,9 +377,15 @@ class _Equilibria:
     """
 
     def __init__(
-        self, blend: LatticeBlend, seed: int = 0, perturbation: float = 1e-2, retries: int = 3
+        self,
+        blend: LatticeBlend,
+        seed: int = 0,
+        perturbation: float = 1e-2,
+        retries: int = 3,
+        env: Surroundings | None = None,
     ) -> None:
         self.blend = blend
+        self.env = env or Surroundings()
         self.seed = seed
         self.perturbation = perturbation
         self.retries = retries
@@ -341,7 +400,10 @@ class _Equilibria:
 
     def _solve(self, model: Model, state: State) -> StaticResult:
         self.solves += 1
-        return solve_static(model, initial=state, options=self.options)
+        env = self.env
+        return solve_static(
+            model, loads=env.loads, initial=state, options=self.options, contact=env.contact
+        )
 
     def _flat(self, scale: float) -> State:
         lat = self.blend.lattice
@@ -357,10 +419,12 @@ class _Equilibria:
         model = self.rod(p)
         lat = self.blend.lattice
         for k in range(self.retries):
-            if _is_minimum(model, res.state):
+            if _is_minimum(model, res.state, self.env):
                 break
             # a symmetric state past its buckling point: kick it out of plane and re-solve
             kick = symmetry_breaking(lat, 5.0**k * self.perturbation * lat.spacing, self.seed + k)
+            if self.env.contact is not None:  # upwards only: never into the floor
+                kick = np.abs(kick)
             start = perturbed_state(model, res.positions - lat.network.nodes)
             start = perturbed_state(
                 model, start.positions - lat.network.nodes + kick[:, None] * [0.0, 0.0, 1.0]
@@ -458,12 +522,15 @@ def misfit_and_gradient(
     target: SurfaceTarget | ShapeTarget,
     size: float,
     nodes: IntArray | None = None,
+    env: Surroundings | None = None,
 ) -> tuple[float, FloatArray]:
     """Aligned misfit ``J`` of the equilibrium ``result`` of design ``p = (c, v)`` and
     ``dJ/dp`` ``(2 E,)`` (per unit mode, then per mm/s).
 
     One adjoint solve at the equilibrium (:func:`rotomorph.inverse.adjoint.adjoint`), whatever
-    the number of edges; ``nodes`` (default all) are the nodes compared with the target.
+    the number of edges; ``nodes`` (default all) are the nodes compared with the target;
+    ``env`` the contact and loads ``result`` was solved with (the barrier's Hessian is part of
+    the adjoint system).
 
     Raises
     ------
@@ -477,7 +544,8 @@ def misfit_and_gradient(
     lay = model.layout
     dj_dx = np.zeros(lay.count)
     dj_dx[(lay.pos[:, None] + np.arange(3)).ravel()] = gx.ravel()
-    s = adjoint(model, result.state, dj_dx).sensitivity
+    env = env or Surroundings()
+    s = adjoint(model, result.state, dj_dx, loads=env.loads, contact=env.contact).sensitivity
     prod = np.stack([s.curvature1, s.curvature2, s.twist], axis=1)
     gc, gv = blend.gradient(c, v, prod, s.rest_length)
     return j, -np.concatenate([gc, gv])
@@ -606,21 +674,22 @@ def _verify(
     size: float,
     lattice: Lattice,
     eq: _Equilibria | None = None,
+    env: Surroundings | None = None,
 ) -> _Check:
     """``p`` solved by ``eq`` (default: a fresh ramp from the flat printed state, as the
-    forward simulation runs it; else warm-started from ``eq``'s last state)."""
-    fresh = _Equilibria(blend, seed=seed) if eq is None else eq
+    forward simulation runs it, in ``env``; else warm-started from ``eq``'s last state)."""
+    fresh = _Equilibria(blend, seed=seed, env=env) if eq is None else eq
     before = fresh.solves
     try:
         res = fresh(p)
     except ConvergenceError:
         if eq is None:
             raise
-        return _verify(blend, p, seed, target, picked, size, lattice)
+        return _verify(blend, p, seed, target, picked, size, lattice, env=fresh.env)
     return _Check(
         result=res,
         misfit=_misfit(target, res.positions, picked, size)[0],
-        stable=_is_minimum(fresh.rod(p), res.state),
+        stable=_is_minimum(fresh.rod(p), res.state, fresh.env),
         fit=fit_quadratic_surface(res.positions[lattice.branch_indices]),
         solves=fresh.solves - before,
         target_k=target.gaussian_curvature,
@@ -640,6 +709,9 @@ def design_lattice(
     speed_range: tuple[float, float] | None = MEASURED_SPEEDS,
     speed_resolution: float = 0.05,
     callback: Callable[[int, float], None] | None = None,
+    contact: bool | Contact = False,
+    floor: bool | Floor = False,
+    gravity: Gravity | None = None,
 ) -> LatticeDesign:
     """Choose per-edge modes and print speeds that make ``lattice`` rise into ``target``.
 
@@ -673,6 +745,12 @@ def design_lattice(
         that lie in ``speed_range``.
     callback
         ``callback(iteration, objective)`` after each optimiser iteration (progress bars).
+    contact, floor, gravity
+        As :func:`rotomorph.lattice.heat_lattice` (self-contact, a floor just below the printed
+        lattice, buoyant self-weight :func:`rotomorph.lattice.heating.lattice_gravity`), in
+        every equilibrium solve and in the adjoint (the barrier's Hessian is part of it), with
+        the barrier stiffness fixed at its default for the printed lattice
+        (:func:`surroundings`). Frictionless only.
 
     Notes
     -----
@@ -697,7 +775,8 @@ def design_lattice(
         A target the lattice cannot reach (height map outside the lattice or too high,
         curvature that would close the lattice on itself).
     InvalidParameterError
-        Bad options (negative printability, an empty speed range, a non-positive resolution).
+        Bad options (negative printability, an empty speed range, a non-positive resolution,
+        friction, gravity without a floor).
     """
     _check_target(lattice, target)
     if isinstance(target, ShapeTarget) and target.positions.shape != lattice.network.nodes.shape:
@@ -709,7 +788,8 @@ def design_lattice(
     _check_options(printability, speed_range, speed_resolution)
     blend = lattice_blend(lattice, actuation)
     size = lattice.spacing * (lattice.n - 1)
-    eq = _Equilibria(blend, seed=seed)
+    env = surroundings(blend, contact=contact, floor=floor, gravity=gravity, seed=seed)
+    eq = _Equilibria(blend, seed=seed, env=env)
     n_edges = blend.n_edges
     if initial is None:
         c0 = np.array([1.0 if m == "expanding" else -1.0 for m in lattice.edge_mode]) * 0.9
@@ -731,7 +811,7 @@ def design_lattice(
             np.full(n_edges, v) for v in np.geomspace(*speed_range, INITIAL_SPEEDS)
         ]
         signs0 = np.where(c0 >= 0, 1.0, -1.0)
-        scan = _Equilibria(blend, seed=seed)  # one ramp, then warm starts along the speeds
+        scan = _Equilibria(blend, seed=seed, env=env)  # one ramp, then warm starts along the speeds
         tried0 = [
             _verify(blend, np.concatenate([signs0, v]), seed, target, picked, size, lattice, scan)
             for v in starts
@@ -745,7 +825,7 @@ def design_lattice(
     def fun(p: FloatArray) -> tuple[float, FloatArray]:
         try:
             res = eq(p)
-            j, grad = misfit_and_gradient(blend, p, res, target, size, picked)
+            j, grad = misfit_and_gradient(blend, p, res, target, size, picked, env)
         except (ConvergenceError, NotAMinimumError):
             return np.inf, np.zeros_like(p)
         c = p[:n_edges]
@@ -792,7 +872,9 @@ def design_lattice(
         candidates.insert(
             0, np.concatenate([signs, _same_strength(blend, c_rel, v_rel, speed_range)])
         )
-    scored = [(_verify(blend, m, seed, target, picked, size, lattice), m) for m in candidates]
+    scored = [
+        (_verify(blend, m, seed, target, picked, size, lattice, env=env), m) for m in candidates
+    ]
     eq.solves += sum(check.solves for check, _ in scored)
     best_check, best = min(scored, key=lambda t: t[0].misfit if t[0].stable else np.inf)
     best_res = best_check.result
@@ -815,7 +897,7 @@ def design_lattice(
     # verification as the forward simulation does it: a fresh ramp from the flat printed state
     base = speeds
 
-    near = _Equilibria(blend, seed=seed)
+    near = _Equilibria(blend, seed=seed, env=env)
 
     def check_scale(scale: float) -> tuple[FloatArray, _Check]:
         v = base
@@ -848,7 +930,9 @@ def design_lattice(
     if check is not tried[1.0][1]:
         # the chosen scale verified as the forward simulation runs it: a fresh ramp (kept only
         # if it is still better than the fresh base design)
-        fresh = _verify(blend, np.concatenate([modes, speeds]), seed, target, picked, size, lattice)
+        fresh = _verify(
+            blend, np.concatenate([modes, speeds]), seed, target, picked, size, lattice, env=env
+        )
         eq.solves += fresh.solves
         speeds, check = min([(speeds, fresh), tried[1.0]], key=lambda t: t[1].rank)
     final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
