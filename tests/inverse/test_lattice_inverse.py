@@ -44,27 +44,39 @@ def test_adjoint_gradient_matches_central_differences(small):
 
     lat, blend = small
     eq = _Equilibria(blend)
-    rng = np.random.default_rng(3)
-    base = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
-    c = np.clip(0.7 * base + rng.uniform(-0.1, 0.1, blend.n_edges), -1, 1)
-    p = np.concatenate([c, rng.uniform(1.0, 2.5, blend.n_edges)])
+    p = _relaxed_design(lat, blend)
     for target in (dome(0.04), saddle(0.04)):
         eq.last = None
         eq.options = SOLVE_OPTIONS
         res = eq(p)
         j, g = misfit_and_gradient(blend, p, res, target, 10.0)
-        eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
-
-        def shifted(e, h, target=target, res=res):
-            pp = p.copy()
-            pp[e] += h
-            eq.last = (p, res.state)
-            return surface_misfit(eq(pp).positions, target, 10.0)[0]
-
-        n = blend.n_edges
-        for e in (0, 9, n + 1, n + 8):
-            fd = richardson_difference(lambda h, e=e: shifted(e, h), 1e-3)
+        for e, fd in _central_differences(eq, p, res, target).items():
             assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
+
+
+def _relaxed_design(lat, blend):
+    """Relaxed modes near the lattice's pattern and random speeds (mm/s)."""
+    rng = np.random.default_rng(3)
+    base = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
+    c = np.clip(0.7 * base + rng.uniform(-0.1, 0.1, blend.n_edges), -1, 1)
+    return np.concatenate([c, rng.uniform(1.0, 2.5, blend.n_edges)])
+
+
+def _central_differences(eq, p, res, target):
+    """dJ/dp of two modes and two speeds by Richardson-extrapolated central differences, the
+    perturbed equilibria warm-started from ``res`` and solved to a relative residual 1e-13."""
+    eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
+
+    def shifted(e, h):
+        pp = p.copy()
+        pp[e] += h
+        eq.last = (p, res.state)
+        return surface_misfit(eq(pp).positions, target, 10.0)[0]
+
+    n = eq.blend.n_edges
+    return {
+        e: richardson_difference(lambda h, e=e: shifted(e, h), 1e-3) for e in (0, 9, n + 1, n + 8)
+    }
 
 
 def test_adjoint_gradient_with_active_contact_matches_central_differences(small):
@@ -76,10 +88,7 @@ def test_adjoint_gradient_with_active_contact_matches_central_differences(small)
     env = surroundings(blend, contact=True, floor=True, gravity=lattice_gravity(lat))
     assert env.contact is not None and env.contact.stiffness is not None  # fixed barrier
     eq = _Equilibria(blend, env=env)
-    rng = np.random.default_rng(3)
-    base = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
-    c = np.clip(0.7 * base + rng.uniform(-0.1, 0.1, blend.n_edges), -1, 1)
-    p = np.concatenate([c, rng.uniform(1.0, 2.5, blend.n_edges)])
+    p = _relaxed_design(lat, blend)
     res = eq(p)
     assert res.contact.active_contacts(res.positions) > 0  # it rests on the floor
     target = dome(0.04)
@@ -88,17 +97,8 @@ def test_adjoint_gradient_with_active_contact_matches_central_differences(small)
         misfit_and_gradient(blend, p, res, target, 10.0)
     # the same barrier, the weight's rest-length term left out
     _, g_no_weight = misfit_and_gradient(blend, p, res, target, 10.0, env=Surroundings(env.contact))
-    eq.options = NewtonOptions(rtol=1e-13, max_iterations=300)
-
-    def shifted(e, h):
-        pp = p.copy()
-        pp[e] += h
-        eq.last = (p, res.state)
-        return surface_misfit(eq(pp).positions, target, 10.0)[0]
-
     n = blend.n_edges
-    for e in (0, 9, n + 1, n + 8):
-        fd = richardson_difference(lambda h, e=e: shifted(e, h), 1e-3)
+    for e, fd in _central_differences(eq, p, res, target).items():
         assert g[e] == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(j))
         if e >= n:  # speeds change the rest lengths, hence the weight
             assert abs(g_no_weight[e] - fd) > 10 * 1e-5 * abs(fd)
