@@ -46,6 +46,16 @@ def test_curve_target_to_a_design_the_other_commands_accept(tmp_path, capsys):
         ('kind = "curve"\n', "schema_version"),
         ('schema_version = 1\nkind = "blob"\n', "kind"),
         ("schema_version = 1\nkind = = 2\n", "not valid TOML"),
+        (
+            'schema_version = 1\nkind = "curve"\n[curve]\nfamily = "helix"\nradius_start = 2.0\n'
+            "radius_end = 2.2\npitch = 1.5\nturns = 1.0\n[contact]\nfloor = true\n",
+            "lattice targets only",
+        ),
+        (
+            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
+            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\nfriction = 0.2\n",
+            "frictionless",
+        ),
     ],
 )
 def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):

@@ -26,6 +26,7 @@ from rotomorph.inverse.lattice import (
     surroundings,
 )
 from rotomorph.inverse.run import lattice_design_file
+from rotomorph.io.designfile import ContactModel
 from rotomorph.lattice.heating import lattice_gravity
 from rotomorph.solve.newton import NewtonOptions
 
@@ -127,6 +128,9 @@ def test_design_is_printable_verified_and_written_as_a_design_file(tmp_path):
     file = lattice_design_file(des, "dome")
     assert file.lattice is not None and file.lattice.pattern == "custom"
     assert [m == "expanding" for m in file.lattice.edge_modes] == list(des.modes > 0)
+    assert file.contact is None
+    on_floor = ContactModel(floor=True, gravity=True)
+    assert lattice_design_file(des, "dome", on_floor).contact == on_floor  # simulate's physics
     # the written design is the verified one, speeds included
     assert file.lattice.to_lattice().edge_mode == des.lattice.edge_mode
     assert np.allclose(file.lattice.to_lattice().speeds, des.speeds)

@@ -25,7 +25,8 @@ from rotomorph.inverse.filament import FilamentDesign, design_filament
 from rotomorph.inverse.lattice import LatticeDesign, design_lattice
 from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
-from rotomorph.io.designfile import Design, parse_design, save_design
+from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
+from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
 
 __all__ = [
     "InverseRun",
@@ -121,9 +122,12 @@ def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Desig
     return parse_design(data)
 
 
-def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
+def lattice_design_file(
+    design: LatticeDesign, name: str = "inverse", contact: ContactModel | None = None
+) -> Design:
     """The design file of a designed lattice (``pattern = "custom"`` with per-edge modes and,
-    where the design chose them, per-edge speeds)."""
+    where the design chose them, per-edge speeds), with the ``[contact]`` table it was designed
+    with (so that ``rotomorph simulate`` verifies the same physics)."""
     lat = design.lattice
     data = {
         "schema_version": 1,
@@ -145,6 +149,7 @@ def lattice_design_file(design: LatticeDesign, name: str = "inverse") -> Design:
                 else {"edge_speeds": [round(v, 6) for v in lat.edge_speeds]}
             ),
         },
+        **({} if contact is None else {"contact": contact.model_dump()}),
     }
     return parse_design(data)
 
@@ -197,6 +202,8 @@ def run_inverse(
             progress(it, value)
 
     surf = target.surface_target()
+    env = lattice_surroundings(target.contact, lat, opt.temperature)
+    env.pop("friction", None)  # 0: the target file refuses friction
     des = design_lattice(
         lat,
         surf,
@@ -204,6 +211,7 @@ def run_inverse(
         speed_range=(opt.min_speed, opt.max_speed),
         speed_resolution=opt.speed_resolution,
         callback=cb,
+        **env,
     )
     k_t = des.target_gaussian_curvature
     k_a = des.achieved_gaussian_curvature
@@ -223,8 +231,10 @@ def run_inverse(
         "expanding_edges": int(np.sum(des.modes > 0)),
         "contracting_edges": int(np.sum(des.modes < 0)),
         "speed_range_mm_s": [float(des.speeds.min()), float(des.speeds.max())],
+        "contact": surroundings_record(target.contact, opt.temperature),
     }
-    return InverseRun(target, lattice_design_file(des, name), summary, log, des)
+    design_file = lattice_design_file(des, name, target.contact)
+    return InverseRun(target, design_file, summary, log, des)
 
 
 def write_inverse(run: InverseRun, design_path: str | Path) -> list[Path]:

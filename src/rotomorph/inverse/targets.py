@@ -24,6 +24,9 @@ Curve families (all lengths in mm):
 Lattice targets (``dome``, ``saddle``, ``height_map``) give the curvatures (1/mm) or a height
 grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``amplitude``,
 ``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
+An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``, ``gravity``,
+``bath``; frictionless only) makes every equilibrium of a lattice design, and its adjoint, touch
+and rest as ``rotomorph simulate`` will; it is copied into the resulting design file.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
+from rotomorph.io.designfile import ContactModel
 
 __all__ = ["TargetFile", "curve_points", "load_target", "parse_target"]
 
@@ -123,6 +127,7 @@ class TargetFile(_Model):
     surface: SurfaceSpec | None = None
     height_map: HeightMapSpec | None = None
     lattice: LatticeSpec | None = None
+    contact: ContactModel | None = None
     options: Options = Options()
 
     @model_validator(mode="after")
@@ -137,6 +142,13 @@ class TargetFile(_Model):
             raise ValueError(f"kind '{self.kind}' needs a [{table}] table")
         if self.kind != "curve" and self.lattice is None:
             raise ValueError(f"kind '{self.kind}' needs a [lattice] table (n, spacing, amplitude)")
+        if self.contact is not None and self.kind == "curve":
+            raise ValueError("[contact] applies to lattice targets only; remove it")
+        if self.contact is not None and self.contact.friction > 0:
+            raise ValueError(
+                "contact.friction must be 0: inverse design needs frictionless contact "
+                "(lagged friction has no adjoint gradient)"
+            )
         if self.options.min_speed >= self.options.max_speed:
             raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
         return self
