@@ -142,7 +142,10 @@ def _compiling_note(args: argparse.Namespace) -> Iterator[None]:
             total=total, desc="compiling kernels", unit="kernel", leave=False, disable=not tty
         ) as bar:
             next_line = 10.0
-            while not done.wait(0.5) and kernels_cached() is False:
+            while not done.wait(0.5):
+                if kernels_cached():
+                    log.info("kernels compiled after %.0f s", time.perf_counter() - t0)
+                    return
                 bar.update(compiled_count() - bar.n)
                 if not tty and time.perf_counter() - t0 >= next_line:
                     log.info("compiling kernels: %d of %d ready", compiled_count(), total)
@@ -156,7 +159,6 @@ def _compiling_note(args: argparse.Namespace) -> Iterator[None]:
         done.set()
         if thread.is_alive():
             thread.join(timeout=2)
-        log.info("kernels ready after %.0f s", time.perf_counter() - t0)
 
 
 def _existing_file(path: str, what: str) -> Path:
