@@ -351,7 +351,7 @@ class PrintProgram:
     ) -> PrintProgram:
         """Keep the active half on the in-plane outer (or inner) side of the path's curvature.
 
-        Notes Q6: α = +π/2·sign κ (outer) or −π/2·sign κ (inner) at each vertex, so the nozzle
+        Convention: α = +π/2·sign κ (outer) or −π/2·sign κ (inner) at each vertex, so the nozzle
         tracks the heading and flips by π at inflections; a vertex with zero curvature
         (|κ| < 1e-9 /mm, e.g. a lattice branch node) gets α = 0, splitting the flip over its two
         edges. Works for any planar path (sinusoid, lattice line, arc).
