@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rotomorph.contact.obstacles import RESTING_GAP
 from rotomorph.errors import InvalidDesignError
 from rotomorph.io.designfile import parse_design
 from rotomorph.simulate.design import simulate_design
 from rotomorph.simulate.run_data import describe_run
-from rotomorph.simulate.surroundings import FLOOR_GAP
 
 # a Janus filament curls to about 0.6 /mm when heated: 13 mm turn through more than a circle
 RING = {
@@ -53,7 +53,7 @@ def test_self_contact_keeps_the_ring_apart():
 def test_on_the_floor_under_buoyant_weight():
     sim, run = _run({"floor": True, "gravity": True})
     r = 0.3
-    floor = -FLOOR_GAP * r  # printed at z = 0
+    floor = -RESTING_GAP * r  # printed at z = 0
     lowest = sim.positions[:, :, 2].min()
     assert lowest >= floor + r * (1 - 1e-3)  # never through the floor
     assert sim.positions[-1, :, 2].max() < floor + 4 * r  # weighed down: stays near the floor

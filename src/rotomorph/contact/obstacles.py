@@ -17,7 +17,7 @@ import numpy as np
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["Cylinder", "Floor", "Obstacle", "Sphere"]
+__all__ = ["RESTING_GAP", "Cylinder", "Floor", "Obstacle", "Sphere"]
 
 
 def _point(field: str, value: object) -> tuple[float, float, float]:
@@ -32,6 +32,11 @@ def _positive(field: str, value: float) -> float:
     if not (np.isfinite(v) and v > 0):
         raise InvalidParameterError(field, f"must be finite and > 0 mm; got {value}")
     return v
+
+
+#: Height of the lowest centre line above a floor it rests on, in filament radii (just outside
+#: contact, so the printed state is admissible).
+RESTING_GAP = 1.005
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,13 @@ class Floor:
     def moved(self, offset: float) -> Floor:
         """The floor raised by ``offset`` (mm) along its normal."""
         return Floor(self.height + float(offset), self.normal)
+
+    @classmethod
+    def under(cls, points: FloatArray, radius: float) -> Floor:
+        """The horizontal floor (normal +z) on which filaments of ``radius`` (mm) through
+        ``points`` (..., 3) rest: the lowest centre line :data:`RESTING_GAP` radii above it."""
+        lowest = float(np.asarray(points, float)[..., 2].min())
+        return cls(height=lowest - RESTING_GAP * float(radius))
 
 
 @dataclass(frozen=True)

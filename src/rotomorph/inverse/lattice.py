@@ -52,7 +52,7 @@ from rotomorph.errors import ConvergenceError, InvalidDesignError, InvalidParame
 from rotomorph.inverse.adjoint import NotAMinimumError, adjoint
 from rotomorph.inverse.blend import LatticeBlend, lattice_blend, with_settings
 from rotomorph.lattice.actuation import Actuation
-from rotomorph.lattice.heating import _contact_settings, perturbed_state, symmetry_breaking
+from rotomorph.lattice.heating import contact_settings, perturbed_state, symmetry_breaking
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
 from rotomorph.solve.continuation import continuation
@@ -342,7 +342,7 @@ def surroundings(
     """
     lattice = blend.lattice
     start = _Equilibria(blend, seed=seed)._flat(1.0)
-    settings = _contact_settings(lattice, start.positions, contact, floor, 0.0)
+    settings = contact_settings(lattice, start.positions, contact, floor, 0.0)
     if settings is not None and settings.friction > 0:
         raise InvalidParameterError(
             "contact.friction", "inverse design needs frictionless contact (friction=0)"

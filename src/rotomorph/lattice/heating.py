@@ -435,7 +435,7 @@ def heat_lattice(
     phase_log.info("set-up: perturbed flat start")
     dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
     initial = perturbed_state(lm.model, dz)
-    settings = _contact_settings(lattice, initial.positions, contact, floor, friction)
+    settings = contact_settings(lattice, initial.positions, contact, floor, friction)
     if gravity is not None and sup.is_free and (settings is None or settings.floor is None):
         raise InvalidParameterError(
             "supports",
@@ -520,7 +520,7 @@ def _stable_flag(result: StaticResult) -> bool | None:
     return True if getattr(result, "stable", None) is True else None
 
 
-def _contact_settings(
+def contact_settings(
     lattice: Lattice,
     printed: FloatArray,
     contact: bool | Contact,
@@ -531,7 +531,7 @@ def _contact_settings(
     if isinstance(floor, Floor):
         fl: Floor | None = floor
     elif floor:
-        fl = Floor(height=float(printed[:, 2].min()) - 1.005 * lattice.radius)
+        fl = Floor.under(printed, lattice.radius)
     else:
         fl = None
     if isinstance(contact, Contact):

@@ -34,7 +34,7 @@ from rotomorph.simulate.filament import (
     FilamentSimulation,
     simulate_filament,
 )
-from rotomorph.simulate.options import check_run_options
+from rotomorph.simulate.options import TEMPERATURE_ACTUATIONS, check_run_options
 from rotomorph.simulate.surroundings import (
     filament_surroundings,
     lattice_surroundings,
@@ -306,11 +306,11 @@ def _lattice_actuation(
     temperature: float | None,
     model: FilamentModel | None,
 ) -> Any:
-    """The actuation object of a lattice run: a temperature ramp for the temperature-driven
-    rules (default 25 → 175 °C, the calibrated model), the rule's name otherwise."""
-    from rotomorph.lattice.actuation import ProgramActuation, ThermalActuation
+    """The actuation of a lattice run: the registered rule, ramped over the run's temperatures
+    (default 25 → 175 °C) with its materials model when it is temperature-driven."""
+    from rotomorph.lattice.actuation import get_actuation
 
-    if rule not in ("program", "thermal"):
+    if rule not in TEMPERATURE_ACTUATIONS:
         return rule
     start = PRINT_TEMPERATURE if start_temperature is None else float(start_temperature)
     end = ACTUATION_TEMPERATURE if temperature is None else float(temperature)
@@ -318,8 +318,8 @@ def _lattice_actuation(
         raise InvalidParameterError(
             "temperature", f"must exceed the start temperature {start:g} °C; got {end:g} °C"
         )
-    cls = ProgramActuation if rule == "program" else ThermalActuation
-    return cls(start=start, end=end, filament_model=model)
+    base: Any = get_actuation(rule)  # ProgramActuation or ThermalActuation (dataclasses)
+    return replace(base, start=start, end=end, filament_model=model)
 
 
 def _simulate_lattice(

@@ -1,10 +1,11 @@
 """What a design's ``[contact]`` table turns into for a run: contact settings, the bath floor
 and the buoyant weight, plus the record of those choices for the run's outputs.
 
-The floor lies just below the printed structure (centre lines ``1.005 r`` above it, as a
-filament printed on the substrate rests); the buoyant line weight is
-(ρ_filament − ρ_bath) g A with ρ_filament the inks' densities weighted by the section's active
-share, and ρ_bath the bath fluid's density at the run's final temperature
+The floor lies just below the printed structure (:meth:`rotomorph.contact.Floor.under`: the
+lowest centre line 1.005 r above it, as a filament printed on the substrate rests); the
+buoyant line weight is (ρ_filament − ρ_bath) g A with ρ_filament the inks' densities
+weighted by the section's active share, and ρ_bath the bath fluid's density at the run's final
+temperature
 (:func:`rotomorph.materials.bath.bath_density`, data and source in the bath-fluid table).
 """
 
@@ -19,10 +20,7 @@ from rotomorph.materials.bath import bath_density, bath_fluids
 from rotomorph.materials.material import get_material
 from rotomorph.solve.loads import Gravity, Loads
 
-__all__ = ["FLOOR_GAP", "filament_surroundings", "lattice_surroundings", "surroundings_record"]
-
-#: Height of the centre line above the floor, in filament radii, of a structure resting on it.
-FLOOR_GAP = 1.005
+__all__ = ["filament_surroundings", "lattice_surroundings", "surroundings_record"]
 
 
 def _density(active: str, passive: str, active_fraction: float) -> float:
@@ -30,10 +28,6 @@ def _density(active: str, passive: str, active_fraction: float) -> float:
     rho_a = get_material(active).density or 1.1
     rho_p = get_material(passive).density or 1.1
     return float(active_fraction * rho_a + (1.0 - active_fraction) * rho_p)
-
-
-def _floor_below(points: Any, radius: float) -> Floor:
-    return Floor(height=float(np.asarray(points)[:, 2].min()) - FLOOR_GAP * float(radius))
 
 
 def filament_surroundings(
@@ -55,7 +49,7 @@ def filament_surroundings(
     if contact is None:
         return None, None
     radius = float(program.radius)
-    obstacles = (_floor_below(program.points, radius),) if contact.floor else ()
+    obstacles = (Floor.under(program.points, radius),) if contact.floor else ()
     settings = Contact(
         radius=radius,
         obstacles=obstacles,
