@@ -21,10 +21,15 @@ from rotomorph.materials.natural import FilamentModel
 
 
 def _natural(
-    monkeypatch: pytest.MonkeyPatch, n: int, memo: bool, clear: bool = True
+    monkeypatch: pytest.MonkeyPatch,
+    n: int,
+    memo: bool,
+    clear: bool = True,
+    every_line: bool = False,
 ) -> tuple[Any, list[np.ndarray], int]:
     """Natural model of an n x n lattice at 150 °C, every state row asked for, rows solved
-    (``clear``: forget what the section remembers first)."""
+    (``clear``: forget what the section remembers first; ``every_line``: evaluate every line's
+    program, also those repeating another line's up to a translation)."""
     asked: list[np.ndarray] = []
     solved = [0]
     natural_strains = FilamentSection.natural_strains
@@ -43,6 +48,8 @@ def _natural(
         return solve_states(self, states)
 
     lattice = sinusoidal_lattice(n)
+    if every_line:
+        lattice._cache[("program_groups",)] = list(range(len(lattice.line_programs())))
     section = FilamentModel().section(
         get_material(lattice.active_material),
         get_material(lattice.passive_material),
@@ -59,7 +66,7 @@ def _natural(
 
 
 def test_each_distinct_print_state_is_solved_once(monkeypatch: pytest.MonkeyPatch) -> None:
-    _, asked, solved = _natural(monkeypatch, 6, memo=True)
+    _, asked, solved = _natural(monkeypatch, 6, memo=True, every_line=True)
     # one solve per distinct state over ALL lines and calls
     assert solved == len(unique_rows(np.concatenate(asked))[0])
     per_call = sum(len(unique_rows(rows)[0]) for rows in asked)
@@ -90,3 +97,43 @@ def test_unique_rows_matches_numpy() -> None:
     assert np.array_equal(states[inverse], table)
     empty_states, empty_inverse = unique_rows(np.zeros((0, 4)))
     assert empty_states.shape == (0, 4) and empty_inverse.shape == (0,)
+
+
+@pytest.mark.parametrize("pattern", ["contracting", "saddle"])
+def test_translated_lines_share_increments_and_give_the_uncached_field(pattern: str) -> None:
+    """Lines whose print programs differ only by their offset share one increment evaluation
+    per temperature; the natural model equals the one computed line by line to 1e-12."""
+    from rotomorph.lattice.actuation import _program_groups
+
+    fm = FilamentModel(resolution=16)
+    lat = sinusoidal_lattice(3, 5.0, 1.25, 6, pattern)
+    lm = lattice_model(lat, stiffness="janus", filament_model=fm)
+    groups = _program_groups(lm)
+    programs = [p for p, _ in lat.line_programs()]
+    assert len(set(groups)) < len(groups)  # the lattice's lines do repeat
+    for line, rep in enumerate(groups):
+        shift = programs[line].points[0] - programs[rep].points[0]
+        assert np.allclose(programs[line].points, programs[rep].points + shift, atol=1e-12)
+    act = ProgramActuation(filament_model=fm)
+    grouped = act.natural(lm, 140.0)
+    lat._cache[("program_groups",)] = list(range(len(groups)))  # every line on its own
+    alone = act.natural(lm, 140.0)
+    for f in ("natural_curvature1", "natural_curvature2", "natural_twist", "rest_length"):
+        a, b = np.asarray(getattr(grouped, f)), np.asarray(getattr(alone, f))
+        assert np.abs(a - b).max() <= 1e-12 * (1.0 + np.abs(b).max()), f
+
+
+def test_a_changed_speed_or_shape_is_not_the_same_program() -> None:
+    from dataclasses import replace
+
+    from rotomorph.lattice.actuation import _same_program
+
+    lat = sinusoidal_lattice(3, 5.0, 1.25, 6, "contracting")
+    p = lat.line_programs()[0][0]
+    moved = replace(p, points=p.points + np.array([3.0, -2.0, 0.5]))
+    assert _same_program(p, moved)
+    assert not _same_program(p, replace(p, speed=p.speed * (1.0 + 1e-9)))
+    bent = p.points.copy()
+    bent[4, 1] += 1e-6
+    assert not _same_program(p, replace(p, points=bent))
+    assert not _same_program(p, replace(p, active_fraction=0.4))

@@ -42,7 +42,7 @@ parameters.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Protocol, runtime_checkable
+from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -51,7 +51,11 @@ from rotomorph.errors import InvalidParameterError
 from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
 from rotomorph.materials.material import get_material
-from rotomorph.materials.natural import FilamentModel, actuation_increments
+from rotomorph.materials.natural import (
+    ActuationIncrements,
+    FilamentModel,
+    actuation_increments,
+)
 from rotomorph.rod.model import Model
 
 __all__ = [
@@ -298,6 +302,59 @@ def _line_stencils(lm: LatticeModel) -> list[tuple[int, IntArray, IntArray, IntA
     return cache[key]  # type: ignore[no-any-return]
 
 
+def _same_program(a: Any, b: Any) -> bool:
+    """Whether print programs ``a`` and ``b`` differ at most by a translation (to round-off).
+
+    Every input of :func:`~rotomorph.materials.natural.actuation_increments` is then equal:
+    the increments depend on the points only through their differences, and on the speeds,
+    nozzle angles and scalar settings themselves. Round-off is the 1e-12 relative tolerance
+    (lines laid out at different offsets differ by a few 1e-16 of their extent).
+    """
+    if any(getattr(a, f) != getattr(b, f) for f in _PROGRAM_SCALARS):
+        return False
+    pa, pb = np.asarray(a.points, dtype=float), np.asarray(b.points, dtype=float)
+    if pa.shape != pb.shape:
+        return False
+    scale = 1.0 + float(np.abs(pa - pa[0]).max(initial=0.0))
+    if not np.allclose(pa - pa[0], pb - pb[0], rtol=0.0, atol=1e-12 * scale):
+        return False
+    for f in ("speed", "nozzle_angle"):
+        u, v = np.asarray(getattr(a, f), dtype=float), np.asarray(getattr(b, f), dtype=float)
+        if u.shape != v.shape or not np.allclose(u, v, rtol=1e-12, atol=1e-12):
+            return False
+    return True
+
+
+#: scalar fields of a print program that must match exactly for two lines to share increments
+_PROGRAM_SCALARS = (
+    "radius",
+    "active_fraction",
+    "active_material",
+    "passive_material",
+    "step_flips",
+)
+
+
+def _program_groups(lm: LatticeModel) -> list[int]:
+    """Per printed line, the first line whose print program equals it up to a translation
+    (:func:`_same_program`): lines of a lattice laid out at a pitch repeat their program, and
+    the actuation increments of a program are computed once per temperature."""
+    key = ("program_groups",)
+    cache = lm.lattice._cache
+    if key not in cache:
+        programs = [p for p, _ in lm.lattice.line_programs()]
+        reps: list[int] = []
+        out = []
+        for k, prog in enumerate(programs):
+            rep = next((r for r in reps if _same_program(programs[r], prog)), None)
+            if rep is None:
+                reps.append(k)
+                rep = k
+            out.append(rep)
+        cache[key] = out
+    return cache[key]  # type: ignore[no-any-return]
+
+
 @dataclass(frozen=True)
 class ProgramActuation:
     """Default mode: each printed line's natural field from its print program at T (°C).
@@ -335,8 +392,15 @@ class ProgramActuation:
         twist = np.zeros(st.count)
         stretch = np.ones(model.network.n_edges)
         programs = lm.lattice.line_programs()
+        groups = _program_groups(lm)
+        increments: dict[int, ActuationIncrements] = {}  # one per distinct program
         for line, rows, stencils, line_edges, model_edges in _line_stencils(lm):
-            inc = actuation_increments(programs[line][0], temperature=float(parameter), model=fm)
+            rep = groups[line]
+            if rep not in increments:
+                increments[rep] = actuation_increments(
+                    programs[rep][0], temperature=float(parameter), model=fm
+                )
+            inc = increments[rep]
             vec[stencils] = inc.curvature[rows]
             twist[stencils] = inc.twist[rows]
             stretch[model_edges] = inc.stretch[line_edges]
