@@ -199,3 +199,36 @@ def test_free_filament_rests_on_two_cylinders_under_its_weight():
     centre = float(w @ res.positions[:, 0] / w.sum())
     moment = left[2] * (-3.0 - centre) + right[2] * (3.0 - centre)
     assert abs(moment) < 1e-3 * weight * 3.0
+
+
+def test_path_check_reusing_the_step_candidates_decides_as_a_fresh_one(rng):
+    """``path_is_free`` after a ``step_bound`` from the same start reuses that step's swept
+    candidates when the path ends near the swept boxes; its verdict equals a fresh broad phase
+    for end points on, near and off the step (crossing rods, a floor, a sphere)."""
+    net = Network(
+        [[-2, 0, 1.2], [0, 0, 1.2], [2, 0, 1.2], [0, -2, 2.3], [0, 0, 2.3], [0, 2, 2.3]],
+        [[0, 1], [1, 2], [3, 4], [4, 5]],
+    )
+    contact = Contact(0.5, (Floor(0.0), Sphere((3.0, 0.0, 1.2), 0.4)), activation_distance=0.05)
+    reused = ContactPotential(contact, net)
+    builds = [0]
+    build = reused._build_candidates
+
+    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
+        builds[0] += 1
+        return build(*args, **kwargs)
+
+    reused._build_candidates = counted  # type: ignore[method-assign]
+    verdicts, checks = [], 0
+    for _ in range(60):
+        x = net.nodes + 0.02 * rng.standard_normal(net.nodes.shape)
+        dx = rng.standard_normal(x.shape) * rng.choice([0.05, 0.3, 1.0])
+        reused.step_bound(x, dx)
+        for beta, wobble in ((1.0, 0.0), (0.5, 0.003), (1.0, 0.006), (0.3, 0.2)):
+            x1 = x + beta * dx + wobble * rng.standard_normal(x.shape)
+            fresh = ContactPotential(contact, net).path_is_free(x, x1)
+            assert reused.path_is_free(x, x1) == fresh
+            verdicts.append(fresh)
+            checks += 1
+    assert any(verdicts) and not all(verdicts)  # both verdicts were exercised
+    assert builds[0] < 60 + checks / 2  # most checks reused the step's candidates

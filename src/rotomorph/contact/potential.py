@@ -44,6 +44,9 @@ MAX_SUBSTEPS = 100_000
 MOLLIFIER = 1e-3
 #: default activation distance relative to the smallest contact distance
 DEFAULT_ACTIVATION = 0.03
+#: how far (per coordinate, relative to the activation distance) a path's end may leave the
+#: boxes swept by the last step bound for its candidates to be reused (``path_is_free``)
+SWEPT_SLACK = 0.25
 
 
 _NO_INT = np.zeros(0, dtype=np.int64)
@@ -221,6 +224,8 @@ class ContactPotential:
         self._lag: FrictionLag | None = None
         # broad-phase cache: reference positions, padded margin, candidates found there
         self._cache: tuple[FloatArray, float, _Candidates] | None = None
+        # the last step bound's start, end and candidates (reused by path_is_free)
+        self._swept: tuple[FloatArray, FloatArray, _Candidates] | None = None
         self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
         deg = np.bincount(edges.ravel(), minlength=n)
         inc = -np.ones((n, max(int(deg.max()), 1)), dtype=np.int64)
@@ -483,6 +488,13 @@ class ContactPotential:
         if disp == 0.0:
             return 1.0
         cand = self._build_candidates(x, 0.0, step=dx)
+        self._swept = (x.copy(), x + dx, cand)
+        return self._bound_on(x, dx, cand, close_fraction)
+
+    def _bound_on(
+        self, x: FloatArray, dx: FloatArray, cand: _Candidates, close_fraction: float
+    ) -> float:
+        """:meth:`step_bound` over the candidate pairs ``cand`` of the step."""
         xe = self._extended(x)
         dxe = np.zeros_like(xe)
         dxe[: self.n_nodes] = dx
@@ -495,8 +507,25 @@ class ContactPotential:
         return float(t)
 
     def path_is_free(self, x0: FloatArray, x1: FloatArray) -> bool:
-        """Whether the straight path ``x0 -> x1`` provably never touches."""
-        return self.step_bound(x0, np.asarray(x1) - np.asarray(x0), close_fraction=1.0) >= 1.0
+        """Whether the straight path ``x0 -> x1`` provably never touches.
+
+        A line-search trial ends near the step its step bound swept from the same start. If
+        every node of ``x1`` lies within ``SWEPT_SLACK`` activation distances (per coordinate)
+        of the box its node swept there, that step's candidates are reused: they hold every
+        pair whose swept boxes came within contact plus the activation distance, and the new
+        boxes lie within ``2 sqrt(3) SWEPT_SLACK < 1`` activation distances of the old ones,
+        so no pair left out can touch along ``x0 -> x1`` (obstacles: the step's largest motion
+        grows by less than the activation distance).
+        """
+        x0 = np.ascontiguousarray(x0, dtype=float)
+        x1 = np.ascontiguousarray(x1, dtype=float)
+        swept = self._swept
+        if swept is not None and swept[0].shape == x0.shape and np.array_equal(swept[0], x0):
+            start, end, cand = swept
+            outside = np.maximum(np.minimum(start, end) - x1, x1 - np.maximum(start, end))
+            if len(x1) == 0 or float(outside.max()) <= SWEPT_SLACK * self.dhat:
+                return self._bound_on(x0, x1 - x0, cand, 1.0) >= 1.0
+        return self.step_bound(x0, x1 - x0, close_fraction=1.0) >= 1.0
 
     # ------------------------------------------------------------------ measures
     def forces(self, x: FloatArray) -> FloatArray:
