@@ -183,7 +183,7 @@ def _additive(lm: LatticeModel, curvature: float, stretch: float = 1.0) -> Model
     b1, b2 = lm.side_basis
     rest = None if stretch == 1.0 else lm.model.network.edge_lengths * stretch
     return lm.model.with_natural(
-        curvature1=k1 + curvature * b1,
+        curvature1=k1 + lm.vertical(curvature * b1),
         curvature2=k2 + curvature * b2,
         rest_length=rest,
     )
@@ -368,11 +368,12 @@ class ProgramActuation:
 
     Notes
     -----
-    The lines are those of :meth:`rotomorph.design.lattices.Lattice.line_programs` (one layer:
-    stacked layers act as one thicker filament of the same shape). Their increments are the
-    frame-free output of :func:`~rotomorph.materials.natural.actuation_increments`, read in
-    the lattice model's frames with :func:`rotomorph.geometry.curvature_increment`, exactly as
-    a single filament reads them in its own.
+    The lines are those of :meth:`rotomorph.design.lattices.Lattice.line_programs` (one layer;
+    the stack of printed layers takes them as :mod:`rotomorph.lattice.model` describes). Their
+    increments are the frame-free output of
+    :func:`~rotomorph.materials.natural.actuation_increments`, read in the lattice model's
+    frames with :func:`rotomorph.geometry.curvature_increment`, exactly as a single filament
+    reads them in its own.
     """
 
     start: float = 25.0
@@ -411,7 +412,7 @@ class ProgramActuation:
         dk1, dk2 = curvature_increment(te, tf, m1[st.edge_e], m1[st.edge_f], vec)
         k1, k2, tw = lm.printed
         return model.with_natural(
-            curvature1=k1 + dk1,
+            curvature1=k1 + lm.vertical(dk1),
             curvature2=k2 + dk2,
             twist=tw + twist,
             rest_length=model.network.edge_lengths * stretch,

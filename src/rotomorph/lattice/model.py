@@ -36,10 +36,32 @@ Stiffness
 ``"paper"``: isotropic circular section of radius R, B1 = B2 = E πR⁴/4, C = G πR⁴/2 with
 G = E/3 (ν = ½; the paper's "diameter a" corrected), EA = E πR².
 ``"janus"``: B_n (toward m1 = n), B_η, C, EA of the meshed Janus section of
-:mod:`rotomorph.materials` at the calibrated actuation modulus ratio. ``layers`` multiplies
-every stiffness by the number of printed layers (stacked layers act as one thicker filament of
-the same shape; the same factor on every edge, so unloaded shapes do not change — it only
-matters against gravity).
+:mod:`rotomorph.materials` at the calibrated actuation modulus ratio, for one printed layer.
+
+Stacked layers
+--------------
+A lattice printed in N layers (the paper's are three) stacks N copies of every edge at
+heights z_k = k h (``layer_height``), each cured onto the one below. With the ``"janus"``
+section the rod is that stack, lumped on its mid-height centre line and treated as a
+perfectly bonded composite beam (Euler–Bernoulli; e.g. Gere & Goodno, *Mechanics of
+Materials*, ch. 6):
+
+* bending in the plane (about the vertical axis) and axial stiffness add: N B_in, N EA;
+* bending out of the plane (toward z) adds each layer's own stiffness and its axial stiffness
+  times the squared distance from the stack's mid-plane (parallel-axis theorem):
+  B_z = N B_z,layer + EA Σ_k (z_k − z̄)²; for three layers at h = 2R this is about 12 × the
+  in-plane value, so the stack resists curling out of its plane far more than one filament;
+* twist: N C, a lower bound that is exact when the layers touch along a narrow fused line
+  (the torsion of the stack as one solid section would be larger);
+* natural strains: every layer carries the same in-plane natural curvature, twist and
+  centre-line strain, so those of the stack are the layer's; a natural curvature toward z
+  (where the interface turns through the horizontal) is resisted by the other layers' axial
+  stiffness, and the stack takes the stiffness-weighted mean N B_z,layer κ_z / B_z
+  (:attr:`LatticeModel.vertical_share`; 1 for one layer).
+
+The stack is an assumption about how the layers fuse (bonded, centre lines h apart). With
+``"paper"`` (the paper's own simulation: one circular filament) ``layers`` only multiplies
+every stiffness, which does not change unloaded shapes.
 """
 
 from __future__ import annotations
@@ -66,6 +88,7 @@ __all__ = [
     "interface_normals",
     "lattice_model",
     "paper_modulus",
+    "stack_moment",
     "stencil_sides",
 ]
 
@@ -93,6 +116,16 @@ def paper_modulus(filament_model: FilamentModel | None = None) -> float:
     fm = FilamentModel() if filament_model is None else filament_model
     e_a, e_p = fm.moduli(get_material("lce"), get_material("acrylate"))
     return 0.5 * (e_a + e_p)
+
+
+def stack_moment(layers: int, layer_height: float) -> float:
+    """Σ_k (z_k − z̄)² of ``layers`` centre lines ``layer_height`` apart (mm²).
+
+    The parallel-axis factor of a bonded stack: its out-of-plane bending stiffness exceeds the
+    sum of the layers' own by this times one layer's axial stiffness. 0 for one layer.
+    """
+    z = layer_height * (np.arange(layers) - 0.5 * (layers - 1))
+    return float(np.sum(z**2))
 
 
 def _stiffness(
@@ -192,6 +225,10 @@ class LatticeModel:
     segments
         ``(E,)`` the lattice network segment each model edge is (all of them for
         :func:`lattice_model`, one edge's for :func:`edge_model`).
+    vertical_share
+        ``(S,)`` share of each stencil's out-of-plane bending stiffness that is the layers' own
+        (module docstring, *Stacked layers*): a natural curvature toward z of one layer is this
+        fraction of the stack's. 1 for one layer or the ``"paper"`` stiffness.
     """
 
     lattice: Lattice
@@ -201,6 +238,11 @@ class LatticeModel:
     rod_vertex: BoolArray
     side_basis: tuple[FloatArray, FloatArray]
     segments: IntArray | None = None
+    vertical_share: FloatArray | None = None
+
+    def vertical(self, dk1: FloatArray) -> FloatArray:
+        """One layer's natural-curvature increment toward z (κ1) as the stack's (1/mm)."""
+        return dk1 if self.vertical_share is None else self.vertical_share * dk1
 
 
 def _build(
@@ -221,15 +263,22 @@ def _build(
     # where n lies in the plane, toward n itself on flip segments (n = +z)
     b1 = np.where(side == 0, b_n, b_eta)
     b2 = np.where(side == 0, b_eta, b_n)
+    n_layers = int(n_layers)
+    # bonded stack (module docstring): parallel-axis term of the layers' axial stiffness
+    steiner = ea * stack_moment(n_layers, lattice.layer_height) if stiffness == "janus" else 0.0
+    b_vertical = n_layers * b1 + steiner
     model = Model(
         network,
-        bending_stiffness1=n_layers * b1,
+        bending_stiffness1=b_vertical,
         bending_stiffness2=n_layers * b2,
         twist_stiffness=n_layers * c,
         axial_stiffness=n_layers * ea,
         directors=np.tile([0.0, 0.0, 1.0], (len(segments), 1)),
     )
     st = model.stencils
+    share = n_layers * b1 / b_vertical
+    vertical_share = 0.5 * (share[st.edge_e] + share[st.edge_f])
+    vertical_share.setflags(write=False)
     mode = np.asarray(lattice.segment_mode)  # a property built on every access: read it once
     seg_expanding = mode[segments] == "expanding"
     rod_vertex = ~np.asarray(st.junction, dtype=bool)
@@ -244,6 +293,7 @@ def _build(
         rod_vertex=rod_vertex,
         side_basis=active_side_basis(side, model),
         segments=segments,
+        vertical_share=vertical_share,
     )
 
 
@@ -269,7 +319,8 @@ def lattice_model(
         Materials modelling choices for ``"janus"`` (and the default E); default
         :class:`~rotomorph.materials.natural.FilamentModel`.
     layers
-        Stiffness multiplier (printed layers); default ``lattice.layers``. Shape-neutral
+        Printed layers stacked on every edge; default ``lattice.layers``. With ``"janus"`` a
+        bonded stack (module docstring); with ``"paper"`` a stiffness multiplier, shape-neutral
         without external loads.
 
     Raises

@@ -155,6 +155,60 @@ class FilamentSection:
         table = np.array([self._solved[key] for key in keys]).reshape(len(keys), 4)[inverse]
         return table[:, 0], table[:, 1:3], table[:, 3]
 
+    def curved_strains(
+        self,
+        omega_star: float | FloatArray,
+        eps_parallel: float | FloatArray,
+        eps_perpendicular: float | FloatArray,
+        eps_passive: float | FloatArray,
+        curvature: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Natural axial strain ``(n,)`` and curvature increment ``(n, 2)`` (1/mm, toward m1, m2,
+        per printed length) of a section printed with curvature ``curvature`` ``(n, 2)``
+        (1/mm, toward m1, m2): the curved-bar theory of
+        :meth:`rotomorph.materials.section.AxialSection.natural_curved`, with the section's
+        mean transverse eigenstrain from Turner's rule (the modulus-weighted mean of the phases'
+        in-plane eigenstrains; Turner, J. Res. NBS 37, 239 (1946)). Equal to
+        :meth:`natural_strains` plus the printed curvature where the curvature is 0.
+        """
+        cols = np.broadcast_arrays(
+            *(np.atleast_1d(np.asarray(a, dtype=float)) for a in
+              (omega_star, eps_parallel, eps_perpendicular, eps_passive)),
+        )  # fmt: skip
+        k0 = np.asarray(curvature, dtype=float).reshape(-1, 2)
+        cols = np.broadcast_arrays(*cols, k0[:, 0])[:4]
+        table = np.column_stack([*cols, k0]) + 0.0
+        states, inverse = unique_rows(table)
+        keys = [row.tobytes() for row in states]
+        missing = [i for i, key in enumerate(keys) if key not in self._solved]
+        if len(self._solved) + len(missing) > SOLVED_STATES_LIMIT:
+            self._solved.clear()
+            missing = list(range(len(keys)))
+        for lo in range(0, len(missing), _BATCH):
+            batch = missing[lo : lo + _BATCH]
+            solved = self._solve_curved(states[batch])
+            self._solved.update(zip((keys[i] for i in batch), solved, strict=True))
+        out = np.array([self._solved[key] for key in keys]).reshape(len(keys), 3)[inverse]
+        return out[:, 0], out[:, 1:3]
+
+    def _solve_curved(self, states: FloatArray) -> FloatArray:
+        """``(m, 3)`` rows (ε_c, κ1, κ2) of distinct curved print states ``(m, 6)``."""
+        w, ep, et, eq = (states[:, i : i + 1] for i in range(4))
+        eps_zz, _ = self.eigenfields(*states[:, :4].T)
+        xy, act = self.axial.points, self.axial.active
+        sin2 = 1.0 - 1.0 / (1.0 + w * w * np.sum(xy * xy, axis=1) / self.radius**2)
+        eps_t = np.where(act, et + 0.5 * (ep - et) * sin2, eq)  # mean in-plane eigenstrain
+        ew = self.axial.modulus * self.axial.weights
+        transverse = eps_t @ ew / self.axial.axial_stiffness
+        k0 = states[:, 4:6]
+        eps_c, dkappa = self.axial.natural_curved(eps_zz, k0, transverse)
+        out = np.column_stack([eps_c, dkappa])
+        straight = ~np.any(k0, axis=1)
+        if straight.any():  # exactly the straight section's values (bit for bit)
+            eps_c, kappa, _ = self.natural_strains(*states[straight, :4].T)
+            out[straight] = np.column_stack([eps_c, kappa])
+        return out
+
     def _solve_states(self, states: FloatArray) -> FloatArray:
         """``(m, 4)`` rows (ε_c, κ1, κ2, Δτ) of distinct print states ``(m, 4)``."""
         eps_zz, gamma = self.eigenfields(*states.T)

@@ -423,8 +423,10 @@ def _vertex_increments(
     section: FilamentSection,
     state: tuple[Material, Material, float],
 ) -> tuple[FloatArray, FloatArray]:
-    """Curvature vector ``(N-2, 3)`` and eigen-twist ``(N-2,)`` at the interior vertices at the
-    temperature of ``state``, sampled at the vertex (midpoint rule on its Voronoi cell).
+    """Curvature vector ``(N-2, 3)``, eigen-twist ``(N-2,)`` and the printed curvature's change of
+    the centre-line strain ``(N-2,)`` at the interior vertices at the temperature of ``state``,
+    sampled at the vertex (midpoint rule on its Voronoi cell). The section is solved as a
+    curved bar with the path's printed curvature (:func:`printed_curvature`).
 
     The active side is the program's vertex interface normal (``vertex_interface_normals``;
     the mean of the two edge normals for programs without it). Sampling at vertices makes a
@@ -441,9 +443,13 @@ def _vertex_increments(
     omega_v = DIRECTOR_HELIX_SENSE * dimensionless_rotation(rot[1:-1], speed[1:-1], radius)
     active, passive, temperature = state
     e_par, e_perp, eps_p = model.strains_at(speed[1:-1], active, passive, temperature)
-    _, kappa, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
+    eps_straight, _, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
     tb = geometry.unit(t[:-1] + t[1:])
-    vec = kappa[:, :1] * n_v + kappa[:, 1:2] * np.cross(tb, n_v)
+    m2 = np.cross(tb, n_v)
+    k0 = printed_curvature(program, section)
+    k0_section = np.column_stack([np.einsum("ij,ij->i", k0, n_v), np.einsum("ij,ij->i", k0, m2)])
+    eps_curved, kappa = section.curved_strains(omega_v, e_par, e_perp, eps_p, k0_section)
+    vec = kappa[:, :1] * n_v + kappa[:, 1:2] * m2
     if getattr(program, "step_flips", False) and vn is not None and len(vec) > 2:
         # a vertex in the middle of a split step flip (both its edges flip) is the step
         # itself: half of its cell on each side, so its increment is the mean of its
@@ -451,7 +457,41 @@ def _vertex_increments(
         mid = _mid_flip(np.asarray(vn, dtype=float))[1:-1]
         mid[0] = mid[-1] = False
         vec[mid] = 0.5 * (vec[np.flatnonzero(mid) - 1] + vec[np.flatnonzero(mid) + 1])
-    return vec, np.asarray(dtau, dtype=float).reshape(-1)
+    return vec, np.asarray(dtau, dtype=float).reshape(-1), eps_curved - eps_straight
+
+
+#: Largest |k0|·(R + |c|) the curved-section theory is applied with (a printed corner sharper
+#: than the filament is a polyline artefact: no extruded filament bends tighter than its size).
+CURVATURE_LIMIT = 0.9
+
+
+def printed_curvature(program: Any, section: FilamentSection) -> FloatArray:
+    """Printed pointwise curvature vectors ``(N-2, 3)`` (1/mm, toward the centre of curvature)
+    at the interior vertices of ``program``'s path, for the curved-section correction.
+
+    Vertices whose curvature radius is below the section's extent (a sharp polyline corner)
+    are limited to :data:`CURVATURE_LIMIT` of it, with a warning.
+    """
+    pts = np.asarray(program.points, dtype=float)
+    e = np.diff(pts, axis=0)
+    kb = geometry.curvature_binormal(e[:-1], e[1:])
+    lengths = np.linalg.norm(e, axis=1)
+    vor = 0.5 * (lengths[:-1] + lengths[1:])
+    tb = geometry.unit(e[:-1] / lengths[:-1, None] + e[1:] / lengths[1:, None])
+    k0 = np.cross(kb, tb) / vor[:, None]
+    extent = section.radius + float(np.linalg.norm(section.axial.centroid))
+    size = np.linalg.norm(k0, axis=1) * extent
+    sharp = size > CURVATURE_LIMIT
+    if np.any(sharp):
+        logger.warning(
+            "%d printed corner(s) turn more sharply than the filament's radius (largest "
+            "|k0|·R = %.3g); the curved-section correction uses |k0|·R = %g there",
+            int(sharp.sum()),
+            float(size.max()),
+            CURVATURE_LIMIT,
+        )
+        k0[sharp] *= (CURVATURE_LIMIT / size[sharp])[:, None]
+    return k0
 
 
 def _flip_edges(vertex_normals: FloatArray) -> BoolArray:
@@ -564,11 +604,17 @@ def actuation_increments(
     vn = getattr(program, "vertex_interface_normals", None)
     if getattr(program, "step_flips", False) and vn is not None:
         normals = _step_flip_normals(normals, np.asarray(vn, dtype=float), t)
-    vec, dtw = _vertex_increments(
+    vec, dtw, deps = _vertex_increments(
         program, t, normals, speed, rot, radius, model, section, (active, passive, temperature)
     )
     measure = model.strain_model.measure
-    axial = np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t))
+    # the curved-section change of the centre-line strain, from the edge's interior end(s)
+    ends = np.zeros((2, len(t)))
+    ends[0, 1:] = deps
+    ends[1, :-1] = deps
+    count = np.full(len(t), 2.0)
+    count[0] = count[-1] = 1.0
+    axial = np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t)) + ends.sum(0) / count
     stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
     return ActuationIncrements(
         curvature=vec,

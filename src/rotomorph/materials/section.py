@@ -107,6 +107,78 @@ class AxialSection:
         # float64 inputs give a float64 solution (the stubs only promise "floating")
         return cast(FloatArray, -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0])
 
+    def natural_curved(
+        self, eigenstrain: FloatArray, curvature: FloatArray, transverse: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        r"""Natural strain and curvature *change* of a section printed on a curved centre line.
+
+        A bar printed with curvature k0 (1/mm, components toward m1, m2: the centre of curvature
+        lies on that side) along its geometric centre line has fibres of reference length
+        ∝ 1 − k0·x (x from the geometric centre, the nozzle's axis): fibres on the inner side
+        are shorter (Winkler's curved bar; e.g. Boresi & Schmidt, *Advanced Mechanics of
+        Materials*, 6th ed., Wiley 2003, ch. 9). With plane sections, a fibre's strain is
+        (ε_g − Δκ·x − ε̄_t k0·x)/(1 − k0·x), ε_g that of the geometric centre, Δκ the change
+        of turning per printed length and ε̄_t x the section's own in-plane dilation (its mean
+        transverse eigenstrain; with a uniform isotropic eigenstrain the bar changes by a
+        similarity, Δκ = 0). Minimising ½∫E(ε − ε*)²(1 − k0·x) dA gives, with
+        w = E/(1 − k0·x) and g = Δκ + ε̄_t k0,
+
+        .. math::
+
+            \begin{pmatrix}∫w & −∫w\,x^T \\ −∫w\,x & ∫w\,x x^T\end{pmatrix}
+            \begin{pmatrix}ε_g \\ g\end{pmatrix}
+            = \begin{pmatrix}∫E ε^* \\ −∫E ε^* x\end{pmatrix};
+
+        the natural strain returned is that of the fibre at the modulus-weighted centroid c,
+        (ε_g − g·c)/(1 − k0·c), as :meth:`natural_strain` (to which, with
+        :meth:`natural_curvature`, the result reduces for k0 = 0). The weights make a
+        contracting phase on the inner side (shorter fibres) bend the bar less, and one on the
+        outer side more, than on a straight bar, by a relative amount of order k0 R.
+
+        Parameters
+        ----------
+        eigenstrain
+            ε*_zz at the quadrature points ``(n, Q)``.
+        curvature
+            Printed curvature k0 ``(n, 2)`` (1/mm); |k0|·|x| < 1 at every point.
+        transverse
+            Mean transverse eigenstrain ε̄_t of the section ``(n,)`` (dimensionless).
+
+        Returns
+        -------
+        eps_c, dkappa
+            ``(n,)`` natural centre-line strain and ``(n, 2)`` change of the natural curvature
+            (1/mm per printed length, toward m1, m2).
+
+        Raises
+        ------
+        InvalidParameterError
+            A fibre of non-positive reference length (|k0| too large for the section).
+        """
+        eps = np.asarray(eigenstrain, dtype=float)
+        k0 = np.asarray(curvature, dtype=float)
+        x = self.points
+        factor = 1.0 - k0 @ x.T  # (n, Q)
+        if np.any(factor <= 0.0):
+            raise InvalidParameterError(
+                "curvature", "printed radius of curvature is smaller than the section's extent"
+            )
+        ew = self.modulus * self.weights
+        w = ew / factor
+        wx = w[..., None] * x  # (n, Q, 2)
+        m = np.empty((*eps.shape[:-1], 3, 3))
+        m[..., 0, 0] = w.sum(axis=-1)
+        m[..., 0, 1:] = m[..., 1:, 0] = -wx.sum(axis=-2)
+        m[..., 1:, 1:] = np.einsum("nqk,ql->nkl", wx, x)
+        rhs = np.empty((*eps.shape[:-1], 3))
+        rhs[..., 0] = np.einsum("nq,q->n", eps, ew)
+        rhs[..., 1:] = -np.einsum("nq,qk->nk", eps, ew[:, None] * x)
+        sol = np.linalg.solve(m, rhs[..., None])[..., 0]
+        eps_g, g = sol[..., 0], sol[..., 1:]
+        eps_c = (eps_g - g @ self.centroid) / (1.0 - k0 @ self.centroid)
+        t = np.asarray(transverse, dtype=float)
+        return eps_c, g - t[..., None] * k0
+
 
 def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> AxialSection:
     """Quadrature of A_E, c and I_E for a meshed section with Young's modulus field E (MPa).
