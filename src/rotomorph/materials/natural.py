@@ -422,7 +422,7 @@ def _vertex_increments(
     model: FilamentModel,
     section: FilamentSection,
     state: tuple[Material, Material, float],
-) -> tuple[FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Curvature vector ``(N-2, 3)``, eigen-twist ``(N-2,)`` and the printed curvature's change of
     the centre-line strain ``(N-2,)`` at the interior vertices at the temperature of ``state``,
     sampled at the vertex (midpoint rule on its Voronoi cell). The section is solved as a
@@ -457,7 +457,8 @@ def _vertex_increments(
         mid = _mid_flip(np.asarray(vn, dtype=float))[1:-1]
         mid[0] = mid[-1] = False
         vec[mid] = 0.5 * (vec[np.flatnonzero(mid) - 1] + vec[np.flatnonzero(mid) + 1])
-    return vec, np.asarray(dtau, dtype=float).reshape(-1), eps_curved - eps_straight
+    deps = np.asarray(eps_curved - eps_straight, dtype=float)
+    return vec, np.asarray(dtau, dtype=float).reshape(-1), deps
 
 
 #: Largest |k0|·(R + |c|) the curved-section theory is applied with (a printed corner sharper
