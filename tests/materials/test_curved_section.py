@@ -1,0 +1,110 @@
+"""A section printed on a curved path: the curved-bar (Winkler) natural strains.
+
+Checks the closed linear solve against a direct numerical minimisation of the same energy, the
+straight limit, the similarity of a uniform isotropic eigenstrain and the asymmetry between an
+active phase on the inner and on the outer side.
+"""
+
+from __future__ import annotations
+
+import logging
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from rotomorph.errors import InvalidParameterError
+from rotomorph.materials.janus import filament_section
+from rotomorph.materials.natural import CURVATURE_LIMIT, printed_curvature
+
+RADIUS = 0.3
+
+
+@pytest.fixture(scope="module")
+def section():  # type: ignore[no-untyped-def]
+    return filament_section(RADIUS, 2.0, 1.0)
+
+
+def _janus_eigenstrain(section, eps=-0.2):  # type: ignore[no-untyped-def]
+    return np.where(section.axial.active, eps, 0.0)[None, :]
+
+
+@pytest.mark.parametrize("k0", [(1.5, 0.0), (-2.0, 0.5), (0.7, -1.9)])
+def test_linear_solve_minimises_the_curved_bar_energy(section, k0) -> None:  # type: ignore[no-untyped-def]
+    ax = section.axial
+    eps = _janus_eigenstrain(section)[0]
+    k = np.asarray(k0)
+    x = ax.points
+    factor = 1.0 - x @ k
+    ew = ax.modulus * ax.weights
+
+    def energy(p: np.ndarray) -> float:
+        strain = (p[0] - x @ p[1:]) / factor  # fibre strain, transverse dilation 0
+        return float(0.5 * np.sum(ew * factor * (strain - eps) ** 2))
+
+    best = minimize(energy, np.zeros(3), method="BFGS", options={"gtol": 1e-14}).x
+    eps_c, dk = ax.natural_curved(eps[None, :], k[None, :], np.zeros(1))
+    assert np.allclose(dk[0], best[1:], rtol=1e-6, atol=1e-7)
+    # the returned strain is that of the fibre at the modulus-weighted centroid
+    c = ax.centroid
+    centroid_strain = (best[0] - best[1:] @ c) / (1.0 - k @ c)
+    assert eps_c[0] == pytest.approx(centroid_strain, rel=1e-6, abs=1e-8)
+
+
+def test_straight_limit_is_the_straight_section(section) -> None:  # type: ignore[no-untyped-def]
+    ax = section.axial
+    eps = _janus_eigenstrain(section)
+    eps_c, dk = ax.natural_curved(eps, np.zeros((1, 2)), np.array([0.05]))
+    assert eps_c[0] == pytest.approx(float(ax.natural_strain(eps)[0]), rel=1e-12)
+    assert np.allclose(dk, ax.natural_curvature(eps), rtol=1e-10, atol=1e-14)
+    # and the filament section returns the straight values bit for bit at k0 = 0
+    straight = section.natural_strains(0.3, -0.25, 0.12, 0.02)
+    curved = section.curved_strains(0.3, -0.25, 0.12, 0.02, np.zeros((1, 2)))
+    assert np.array_equal(curved[0], straight[0]) and np.array_equal(curved[1], straight[1])
+
+
+@pytest.mark.parametrize("k0", [(2.0, 0.0), (-1.0, 2.2)])
+def test_uniform_isotropic_eigenstrain_is_a_similarity(section, k0) -> None:  # type: ignore[no-untyped-def]
+    ax = section.axial
+    e = -0.15
+    eps = np.full((1, len(ax.points)), e)
+    eps_c, dk = ax.natural_curved(eps, np.asarray(k0, dtype=float)[None, :], np.array([e]))
+    assert eps_c[0] == pytest.approx(e, rel=1e-12)
+    assert np.allclose(dk, 0.0, atol=1e-12)  # turning per printed length unchanged
+
+
+def test_inner_active_curls_less_and_outer_active_straightens_more(section) -> None:  # type: ignore[no-untyped-def]
+    args = (0.0, -0.3, 0.15, 0.03)
+    _, straight, _ = section.natural_strains(*args)
+    k_straight = float(straight[0, 0])  # toward the active side (m1 = n), > 0
+    assert k_straight > 0.0
+    k0 = 0.5 / RADIUS
+    _, inner = section.curved_strains(*args, np.array([[k0, 0.0]]))  # centre on active side
+    _, outer = section.curved_strains(*args, np.array([[-k0, 0.0]]))
+    assert 0.0 < inner[0, 0] < 0.8 * k_straight
+    assert outer[0, 0] > 1.2 * k_straight
+    # mirror symmetry of the half-and-half section: no curvature across the interface normal
+    assert abs(inner[0, 1]) < 1e-9 and abs(outer[0, 1]) < 1e-9
+
+
+def test_fibre_of_negative_length_is_refused(section) -> None:  # type: ignore[no-untyped-def]
+    eps = _janus_eigenstrain(section)
+    with pytest.raises(InvalidParameterError, match="curvature"):
+        section.axial.natural_curved(eps, np.array([[1.5 / RADIUS, 0.0]]), np.zeros(1))
+
+
+def test_printed_curvature_of_a_circle_and_a_sharp_corner(section, caplog) -> None:  # type: ignore[no-untyped-def]
+    rho = 2.0
+    s = np.linspace(0.0, 1.0, 41)
+    circle = np.column_stack([rho * np.cos(s), rho * np.sin(s), np.zeros_like(s)])
+    k0 = printed_curvature(SimpleNamespace(points=circle), section)
+    assert np.allclose(np.linalg.norm(k0, axis=1), 1.0 / rho, rtol=1e-3)
+    centre = -circle[1:-1] / rho  # toward the centre of curvature
+    assert np.allclose(k0 * rho, centre, atol=1e-3)
+    corner = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.1, 0.0]])
+    with caplog.at_level(logging.WARNING, logger="rotomorph.materials.natural"):
+        k = printed_curvature(SimpleNamespace(points=corner), section)
+    extent = section.radius + np.linalg.norm(section.axial.centroid)
+    assert np.linalg.norm(k[0]) * extent == pytest.approx(CURVATURE_LIMIT)
+    assert "sharply" in caplog.text
