@@ -20,8 +20,11 @@ speed law, so a vertex increment is :math:`\sum_q U_q\,\sigma_q(u)`, with the un
 edges; its unit responses are tabulated for the four mode combinations and blended bilinearly.
 A segment's centre-line strain :math:`\varepsilon_c` is evaluated directly from the section law
 at the segment's mean speed and rotation number, as the chain does; its rest length is the
-printed length times :math:`e^{\varepsilon_c}` (Hencky) or :math:`1 + \varepsilon_c`. The
-blend is checked against the forward actuation at random modes and speeds when it is built.
+printed length times :math:`e^{\varepsilon_c}` (Hencky) or :math:`1 + \varepsilon_c`, plus
+the change the printed curvature makes at its end vertices (the curved-bar section of
+:mod:`rotomorph.materials.section`): linear in the vertex's free strains, tabulated per mode
+with unit strains and blended like the stencils. The blend is checked against the forward
+actuation at random modes and speeds when it is built.
 
 Derivatives
 -----------
@@ -51,7 +54,11 @@ from rotomorph.lattice.actuation import (
 )
 from rotomorph.lattice.model import lattice_model
 from rotomorph.materials.material import get_material
-from rotomorph.materials.natural import DIRECTOR_HELIX_SENSE, FilamentModel
+from rotomorph.materials.natural import (
+    DIRECTOR_HELIX_SENSE,
+    FilamentModel,
+    actuation_increments,
+)
 from rotomorph.rod.model import Model
 
 __all__ = ["LatticeBlend", "lattice_blend", "with_settings"]
@@ -72,6 +79,19 @@ class _MarkedStrains:
     def active_strains(self, speed: Any) -> tuple[FloatArray, FloatArray]:
         hit = np.asarray(speed, dtype=float) == self.marker
         return np.where(hit, self.parallel, 0.0), np.where(hit, self.perpendicular, 0.0)
+
+
+@dataclass(frozen=True)
+class _UnitStrains:
+    """A strain law giving the same (ε∥, ε⊥) at every speed: unit responses."""
+
+    parallel: float
+    perpendicular: float
+    measure: Any
+
+    def active_strains(self, speed: Any) -> tuple[FloatArray, FloatArray]:
+        shape = np.shape(speed)
+        return np.full(shape, self.parallel), np.full(shape, self.perpendicular)
 
 
 @dataclass(frozen=True, eq=False)
@@ -161,6 +181,11 @@ class LatticeBlend:
     segment_units
         ``(E, 3)`` centre-line strain per unit free strain of the segments printed at one
         speed (their ω* does not depend on it); NaN on segments between two speeds.
+    segment_curved
+        ``(E, 2, 2, 3)``: the printed curvature's change of each segment's centre-line strain
+        from its vertex ``r`` (axis 1), for its edge printed expanding / contracting (axis 2),
+        per unit full-actuation free strain (ε∥, ε⊥, ε_p) at that vertex's speed (edge weights
+        included).
     speeds
         Default speeds ``(n_edges,)`` (mm/s), the lattice's own.
     """
@@ -174,6 +199,7 @@ class LatticeBlend:
     segment_speed_edges: IntArray
     segment_rate: FloatArray
     segment_units: FloatArray
+    segment_curved: FloatArray
     speeds: FloatArray
     chain: _Chain = field(repr=False)
     factor: FloatArray = field(repr=False)
@@ -224,6 +250,30 @@ class LatticeBlend:
         units[mixed] = self.chain.axial_units(omega[mixed])
         return omega, mean, units
 
+    def _free(self, speed: FloatArray) -> FloatArray:
+        """``(n, 3)`` free strains (ε∥, ε⊥, ε_p) the unit responses multiply (as the stencils')."""
+        sig = self.chain.strains(speed)
+        return np.concatenate([sig, np.full((len(sig), 1), self.chain.passive_strain)], axis=1)
+
+    def _curved(self, c: FloatArray, v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Curved-section strain change of every segment ``(E,)`` and its derivatives: per
+        segment and end ``r`` the mode derivative ``(E, 2)`` and the strain-weighted unit
+        response ``(E, 2, 3)`` that multiplies d(free strain)/d(speed)."""
+        c = np.asarray(c, dtype=float)
+        ce = c[self.segment_edge]
+        w = np.stack([0.5 * (1 + ce), 0.5 * (1 - ce)], axis=1)  # (E, 2) modes
+        total = np.zeros(len(ce))
+        d_mode = np.zeros((len(ce), 2))
+        blended = np.zeros((len(ce), 2, 3))
+        for r in (0, 1):
+            sig = self._free(v[self.segment_speed_edges[:, r]])
+            unit = self.segment_curved[:, r]  # (E, 2 modes, 3)
+            per_mode = np.einsum("emq,eq->em", unit, sig)
+            total += np.sum(w * per_mode, axis=1)
+            d_mode[:, r] = 0.5 * (per_mode[:, 0] - per_mode[:, 1])
+            blended[:, r] = np.einsum("em,emq->eq", w, unit)
+        return total, d_mode, blended
+
     def natural(
         self, c: FloatArray, v: FloatArray | None = None, t: float = 1.0
     ) -> tuple[FloatArray, FloatArray]:
@@ -233,7 +283,8 @@ class LatticeBlend:
         wa, wb = self._weights(c)
         inc = np.einsum("si,sj,sijkq,sq->sk", wa, wb, self.units, self._sources(v))
         _, mean, units = self._axial(v)
-        eps = t * np.sum(units * self.chain.strains_at(mean), axis=1)
+        curved, _, _ = self._curved(c, v)
+        eps = t * (np.sum(units * self.chain.strains_at(mean), axis=1) + curved)
         stretch = np.exp(eps) if self.hencky else 1.0 + eps
         return self.printed + t * inc, self.printed_length * stretch
 
@@ -270,7 +321,8 @@ class LatticeBlend:
         # rest lengths: eps_c = units(omega*(ua, ub)) . strains(mean(ua, ub)), chain rule
         omega, mean, units = self._axial(v)
         sig_seg = self.chain.strains_at(mean)
-        eps = np.sum(units * sig_seg, axis=1)
+        curved, d_mode, curved_units = self._curved(c, v)
+        eps = np.sum(units * sig_seg, axis=1) + curved
         rest = self.printed_length * (np.exp(eps) if self.hencky else 1.0 + eps)
         d_rest = rest if self.hencky else self.printed_length
         d_mean = np.sum(units * self.chain.strains_at_rates(mean), axis=1)
@@ -290,6 +342,12 @@ class LatticeBlend:
         w = rest_products * d_rest
         np.add.at(gv, self.segment_speed_edges[:, 0], w * (d_omega * dom_a + 0.5 * d_mean))
         np.add.at(gv, self.segment_speed_edges[:, 1], w * (d_omega * dom_b + 0.5 * d_mean))
+        # the curved-section change: the segment's edge mode, each end vertex's speed
+        np.add.at(gc, self.segment_edge, w * d_mode.sum(axis=1))
+        for r in (0, 1):
+            edge = self.segment_speed_edges[:, r]
+            rates = self.chain.strain_rates(v[edge])  # the passive strain does not depend on v
+            np.add.at(gv, edge, w * np.sum(curved_units[:, r, :2] * rates, axis=1))
         return gc, gv
 
     def rod(self, c: FloatArray, v: FloatArray | None = None, t: float = 1.0) -> Model:
@@ -462,6 +520,7 @@ def lattice_blend(
         seg_rate[segs] = np.stack([half[:-1], half[1:]], axis=1)
     ones = np.ones(st.count)
     chain = _Chain(fm, lattice, float(act.end))
+    seg_curved = _segment_curved(lattice, fm, float(act.end))
     single = seg_speed[:, 0] == seg_speed[:, 1]
     seg_units = np.full((n_seg, 3), np.nan)
     seg_units[single] = chain.axial_units(seg_rate[single].sum(axis=1))
@@ -475,6 +534,7 @@ def lattice_blend(
         segment_speed_edges=seg_speed,
         segment_rate=seg_rate,
         segment_units=seg_units,
+        segment_curved=seg_curved,
         speeds=lattice.speeds,
         chain=chain,
         factor=np.asarray(base.model.with_natural(curvature1=ones).integrated_natural()[0]),
@@ -482,6 +542,32 @@ def lattice_blend(
     )
     _check_blend(blend, act, stiffness, fm, rng)
     return blend
+
+
+def _segment_curved(lattice: Lattice, fm: FilamentModel, temperature: float) -> FloatArray:
+    """``(E, 2, 2, 3)`` curved-section strain change of every segment from its vertex ``r``, for
+    its edge expanding / contracting, per unit free strain (:attr:`LatticeBlend.segment_curved`):
+    read off :func:`~rotomorph.materials.natural.actuation_increments` of every printed line
+    with uniform modes and unit strain laws. An edge takes the mean of its interior ends."""
+    out = np.zeros((lattice.network.n_edges, 2, 2, 3))
+    n_edges = len(lattice.edge_chains)
+    measure = fm.strain_model.measure
+    laws = [
+        replace(fm, strain_model=_UnitStrains(1.0, 0.0, measure), passive_strain=0.0),
+        replace(fm, strain_model=_UnitStrains(0.0, 1.0, measure), passive_strain=0.0),
+        replace(fm, strain_model=_UnitStrains(0.0, 0.0, measure), passive_strain=1.0),
+    ]
+    for m, sign in enumerate((1.0, -1.0)):
+        lat = with_settings(lattice, np.full(n_edges, sign), lattice.speeds)
+        for q, law in enumerate(laws):
+            for prog, segs in lat.line_programs():
+                deps = actuation_increments(prog, temperature=temperature, model=law).curved_strain
+                n = len(segs)
+                count = np.full(n, 2.0)
+                count[0] = count[-1] = 1.0
+                out[segs[1:], 0, m, q] = deps / count[1:]  # vertex j is segment j's start
+                out[segs[:-1], 1, m, q] = deps / count[:-1]  # and segment j-1's end
+    return out
 
 
 def _zero_unactuated(units: FloatArray) -> None:

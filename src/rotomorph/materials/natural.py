@@ -546,7 +546,11 @@ class ActuationIncrements:
     twist
         ``(N-2,)`` eigen-twist added at the interior vertices (1/mm per printed length).
     axial_strain
-        ``(N-1,)`` natural centre-line strain ε_c(T) of each edge (model's measure).
+        ``(N-1,)`` natural centre-line strain ε_c(T) of each edge (model's measure), the
+        printed curvature's change included.
+    curved_strain
+        ``(N-2,)`` that change at the interior vertices (curved-bar section minus straight);
+        an edge takes the mean of its interior end vertices'.
     stretch
         ``(N-1,)`` rest length / printed length of each edge.
     normals
@@ -564,6 +568,7 @@ class ActuationIncrements:
     curvature: FloatArray
     twist: FloatArray
     axial_strain: FloatArray
+    curved_strain: FloatArray
     stretch: FloatArray
     normals: FloatArray
     omega_star: FloatArray
@@ -621,6 +626,7 @@ def actuation_increments(
         curvature=vec,
         twist=dtw,
         axial_strain=axial,
+        curved_strain=deps,
         stretch=stretch,
         normals=normals,
         omega_star=np.asarray(omega_star, dtype=float),
