@@ -19,8 +19,10 @@ def test_stack_moment() -> None:
 @pytest.fixture(scope="module")
 def models():  # type: ignore[no-untyped-def]
     lat = sinusoidal_lattice(3, pattern="contracting")
-    return lat, lattice_model(lat, stiffness="janus", layers=1), lattice_model(
-        lat, stiffness="janus"
+    return (
+        lat,
+        lattice_model(lat, stiffness="janus", layers=1),
+        lattice_model(lat, stiffness="janus"),
     )
 
 
@@ -44,7 +46,7 @@ def test_stack_shares_only_the_vertical_natural_curvature(models) -> None:  # ty
     _, one, three = models
     act = ProgramActuation()
     a, b = act.natural(one, 175.0), act.natural(three, 175.0)
-    k1p, k2p, _ = one.printed
+    k1p, _, _ = one.printed
     assert np.allclose(b.natural_curvature2, a.natural_curvature2, rtol=1e-12, atol=1e-15)
     assert np.allclose(b.natural_twist, a.natural_twist, rtol=1e-12, atol=1e-15)
     d1 = np.asarray(a.natural_curvature1) - k1p
