@@ -6,9 +6,9 @@ The paper's two applications of active–passive lattices (its Fig. 5), computed
 **Filter.** An expanding lattice catches spheres when cold and lets them through when hot. A
 sphere of diameter ``D`` passes a unit cell when a circle of diameter ``D`` fits between the
 filament surfaces of the cell (:func:`rotomorph.analysis.aperture.passing_diameters`). The
-example follows the opening of every cell over a heating ramp (physical temperature mode,
-25 → 175 °C) and says, for each sphere diameter, from which temperature it passes. The paper's
-objects are 5 mm spheres.
+example follows the opening of every cell over a heating ramp (25 → 175 °C, every printed line
+driven by its print program through the materials chain) and says, for each sphere diameter,
+from which temperature it passes. The paper's objects are 5 mm spheres.
 
 **Gripper.** A contracting lattice closes on rods standing in its cells when hot and releases
 them when cooled (the paper heats to 175 °C and cools to 50 °C; acrylic rods 3.5 mm in diameter,
@@ -37,7 +37,7 @@ import numpy as np
 from rotomorph.analysis.aperture import passing_diameters
 from rotomorph.contact import Contact, ContactPotential, Cylinder
 from rotomorph.design.lattices import Lattice, sinusoidal_lattice
-from rotomorph.lattice.actuation import get_actuation
+from rotomorph.lattice.actuation import default_stiffness, get_actuation
 from rotomorph.lattice.heating import RAMP_OPTIONS, heat_lattice
 from rotomorph.lattice.model import lattice_model
 from rotomorph.solve.continuation import continuation
@@ -61,7 +61,7 @@ def filter_study(n: int, ghost_nodes: int, steps: int) -> tuple[list[dict], dict
     lattice = sinusoidal_lattice(
         n=n, ghost_nodes=ghost_nodes, spacing=FILTER_SPACING, amplitude=0.25 * FILTER_SPACING
     )
-    ramp = heat_lattice(lattice, actuation="thermal", steps=steps, supports="pinned-centre")
+    ramp = heat_lattice(lattice, actuation="program", steps=steps, supports="pinned-centre")
     openings = np.array(
         [passing_diameters(p, lattice.edge_chains, n, lattice.radius) for p in ramp.positions]
     )
@@ -131,8 +131,9 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
         amplitude=0.25 * GRIPPER_SPACING,
         pattern="contracting",
     )
-    model = lattice_model(lattice)
-    thermal = get_actuation("thermal")
+    program = get_actuation("program")
+    stiffness, materials = default_stiffness(program)
+    model = lattice_model(lattice, stiffness=stiffness, filament_model=materials)
     supports = centre_support(lattice)
     rods = tuple(
         Cylinder.along((x, y, 0.0), (0.0, 0.0, 1.0), ROD_DIAMETER / 2, ROD_LENGTH)
@@ -142,7 +143,7 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
 
     def solve(temperature: float, state):  # type: ignore[no-untyped-def]
         return solve_static(
-            thermal.natural(model, temperature),
+            program.natural(model, temperature),
             supports,
             Loads(),
             initial=state,
@@ -150,16 +151,16 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
             contact=contact,
         )
 
-    heating = np.linspace(thermal.start, HOT, heat_steps + 1)[1:]
+    heating = np.linspace(program.start, HOT, heat_steps + 1)[1:]
     cooling = np.linspace(HOT, RELEASE, cool_steps + 1)[1:]
-    up = continuation(solve, heating, model.model.reference_state(), start=thermal.start)
+    up = continuation(solve, heating, model.model.reference_state(), start=program.start)
     down = continuation(solve, cooling, up.final.state, start=HOT)
     rows = []
     printed = passing_diameters(lattice.network.nodes, lattice.edge_chains, n, lattice.radius)
     rows.append(
         {
             "study": "gripper",
-            "temperature_C": thermal.start,
+            "temperature_C": program.start,
             "phase": "printed",
             "rod_forces_N": [0.0] * len(rods),
             "opening_min_mm": float(printed.min()),
