@@ -12,6 +12,7 @@ from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.design.path import Arc, Line, Path, Sinusoid
 from rotomorph.design.program import PrintProgram
 from rotomorph.lattice.model import lattice_model
+from rotomorph.materials.material import get_material
 from rotomorph.materials.natural import FilamentModel, natural_field
 from rotomorph.rod.model import Model
 from rotomorph.solve.static import solve_static
@@ -75,22 +76,32 @@ def test_uniform_contraction_of_a_printed_filament_is_a_similarity(name):
     assert res.energy < 1e-12
 
 
-def test_pure_lce_arc_keeps_its_turning_angle():
-    # the regression that motivated the fix: a pure-LCE printed arc of 1.5 rad turned through
-    # 1.197 rad once heated, because per-length curvature was multiplied by a shortened length
+def test_pure_lce_arc_turns_by_its_metric_not_by_its_shrinkage():
+    # a pure-LCE arc whose director follows the arc contracts along it (ε∥) and swells across
+    # it (ε⊥): concentric fibres all shorten by the same factor while their spacing grows, so
+    # the arc's turning angle becomes θ (1 + ε∥)/(1 + ε⊥) (the in-plane metric; to first order
+    # θ (1 + ε∥ − ε⊥), the curved-bar section's linear result). An earlier bug multiplied the
+    # per-length curvature by the shortened length instead, θ (1 + ε∥): 1.5 -> 1.197 rad.
     path = Path.from_segments([Arc(4.0, 1.5)], spacing=0.05)
     # a nozzle that does not rotate: no director helix, hence no eigen-twist
     program = PrintProgram.from_rotation(path, 3.0, 0.0, active_fraction=1.0)
-    field = natural_field(program, temperature=175.0)
+    fm = FilamentModel()
+    field = natural_field(program, temperature=175.0, model=fm)
     assert np.all(field.axial_strain < -0.1)  # the LCE contracts along its director
+    lce, acrylate = get_material("lce"), get_material("acrylate")
+    e_par, e_perp, _ = fm.strains_at(np.array([3.0]), lce, acrylate, 175.0)
+    e_par, e_perp = float(e_par[0]), float(e_perp[0])
+    assert e_perp > 0.0 > e_par
 
     def turning(x: np.ndarray) -> float:
         t0, t1 = x[1] - x[0], x[-1] - x[-2]
         return float(np.arctan2(np.cross(t0, t1)[2], np.dot(t0, t1)))
 
     x = solve_static(Model.from_field(program.points, field)).positions
-    assert turning(program.points) == pytest.approx(1.5, rel=0.02)
-    assert turning(x) == pytest.approx(turning(program.points), abs=1e-8)
+    printed = turning(program.points)
+    assert printed == pytest.approx(1.5, rel=0.02)
+    assert turning(x) == pytest.approx(printed * (1.0 + e_par - e_perp), rel=1e-3)
+    assert abs(turning(x) - printed * np.exp(e_par)) > 0.05  # not the shrinkage bug
 
 
 def test_uniform_rest_length_change_of_a_lattice_is_a_similarity():

@@ -461,8 +461,9 @@ def _vertex_increments(
     return vec, np.asarray(dtau, dtype=float).reshape(-1), deps
 
 
-#: Largest |k0|·(R + |c|) the curved-section theory is applied with (a printed corner sharper
-#: than the filament is a polyline artefact: no extruded filament bends tighter than its size).
+#: Largest ``|k0| (R + |c|)`` the curved-section theory is applied with (a printed corner
+#: sharper than the filament is a polyline artefact: no extruded filament bends tighter than
+#: its size).
 CURVATURE_LIMIT = 0.9
 
 

@@ -140,7 +140,7 @@ class AxialSection:
         eigenstrain
             ε*_zz at the quadrature points ``(n, Q)``.
         curvature
-            Printed curvature k0 ``(n, 2)`` (1/mm); |k0|·|x| < 1 at every point.
+            Printed curvature k0 ``(n, 2)`` (1/mm); ``|k0|·|x| < 1`` at every point.
         transverse
             Mean transverse eigenstrain ε̄_t of the section ``(n,)`` (dimensionless).
 
@@ -153,7 +153,7 @@ class AxialSection:
         Raises
         ------
         InvalidParameterError
-            A fibre of non-positive reference length (|k0| too large for the section).
+            A fibre of non-positive reference length (``|k0|`` too large for the section).
         """
         eps = np.asarray(eigenstrain, dtype=float)
         k0 = np.asarray(curvature, dtype=float)
