@@ -373,7 +373,8 @@ class ProgramActuation:
     increments are the frame-free output of
     :func:`~rotomorph.materials.natural.actuation_increments`, read in the lattice model's
     frames with :func:`rotomorph.geometry.curvature_increment`, exactly as a single filament
-    reads them in its own.
+    reads them in its own. Lines whose programs differ only by a translation
+    (:func:`_same_program`) share one evaluation per temperature.
     """
 
     start: float = 25.0
