@@ -49,7 +49,7 @@ def _natural(
 
     lattice = sinusoidal_lattice(n)
     if every_line:
-        lattice._cache[("program_groups",)] = list(range(len(lattice.line_programs())))
+        lattice._cache[("program_groups",)] = [(k, 0) for k in range(len(lattice.line_programs()))]
     section = FilamentModel().section(
         get_material(lattice.active_material),
         get_material(lattice.passive_material),
@@ -100,40 +100,54 @@ def test_unique_rows_matches_numpy() -> None:
 
 
 @pytest.mark.parametrize("pattern", ["contracting", "saddle"])
-def test_translated_lines_share_increments_and_give_the_uncached_field(pattern: str) -> None:
-    """Lines whose print programs differ only by their offset share one increment evaluation
-    per temperature; the natural model equals the one computed line by line to 1e-12."""
-    from rotomorph.lattice.actuation import _program_groups
+def test_repeated_lines_share_increments_and_give_the_uncached_field(pattern: str) -> None:
+    """Lines whose print programs differ only by their offset and a quarter turn about +z
+    (x- and y-lines) share one increment evaluation per temperature; the natural model equals
+    the one computed line by line to 1e-12."""
+    from rotomorph.lattice.actuation import _program_groups, _turn
 
     fm = FilamentModel(resolution=16)
     lat = sinusoidal_lattice(3, 5.0, 1.25, 6, pattern)
     lm = lattice_model(lat, stiffness="janus", filament_model=fm)
     groups = _program_groups(lm)
     programs = [p for p, _ in lat.line_programs()]
-    assert len(set(groups)) < len(groups)  # the lattice's lines do repeat
-    for line, rep in enumerate(groups):
-        shift = programs[line].points[0] - programs[rep].points[0]
-        assert np.allclose(programs[line].points, programs[rep].points + shift, atol=1e-12)
+    assert len({rep for rep, _ in groups}) < len(groups) // 2  # x- and y-lines repeat
+    assert {turns for _, turns in groups} == {0, 1}
+    for line, (rep, turns) in enumerate(groups):
+        a, b = programs[rep].points, programs[line].points
+        assert np.allclose(_turn(a - a[0], turns), b - b[0], atol=1e-12)
     act = ProgramActuation(filament_model=fm)
     grouped = act.natural(lm, 140.0)
-    lat._cache[("program_groups",)] = list(range(len(groups)))  # every line on its own
+    lat._cache[("program_groups",)] = [(k, 0) for k in range(len(groups))]  # each on its own
     alone = act.natural(lm, 140.0)
     for f in ("natural_curvature1", "natural_curvature2", "natural_twist", "rest_length"):
         a, b = np.asarray(getattr(grouped, f)), np.asarray(getattr(alone, f))
         assert np.abs(a - b).max() <= 1e-12 * (1.0 + np.abs(b).max()), f
 
 
-def test_a_changed_speed_or_shape_is_not_the_same_program() -> None:
+def test_a_changed_speed_shape_or_nozzle_is_not_the_same_program() -> None:
     from dataclasses import replace
 
-    from rotomorph.lattice.actuation import _same_program
+    from rotomorph.lattice.actuation import _program_turns, _turn
+    from rotomorph.materials.natural import actuation_increments
 
     lat = sinusoidal_lattice(3, 5.0, 1.25, 6, "contracting")
     p = lat.line_programs()[0][0]
     moved = replace(p, points=p.points + np.array([3.0, -2.0, 0.5]))
-    assert _same_program(p, moved)
-    assert not _same_program(p, replace(p, speed=p.speed * (1.0 + 1e-9)))
+    assert _program_turns(p, moved) == 0
+    assert _program_turns(p, replace(p, speed=p.speed * (1.0 + 1e-9))) is None
     bent = p.points.copy()
     bent[4, 1] += 1e-6
-    assert not _same_program(p, replace(p, points=bent))
-    assert not _same_program(p, replace(p, active_fraction=0.4))
+    assert _program_turns(p, replace(p, points=bent)) is None
+    assert _program_turns(p, replace(p, active_fraction=0.4)) is None
+    # turned by three quarter turns: the path and the lab nozzle angle together
+    turned = replace(p, points=_turn(p.points, 3), nozzle_angle=p.nozzle_angle + 1.5 * np.pi)
+    assert _program_turns(p, turned) == 3
+    assert _program_turns(p, replace(turned, nozzle_angle=p.nozzle_angle)) is None
+    # and the increments turn with it (what the shared evaluation relies on)
+    fm = FilamentModel(resolution=16)
+    a = actuation_increments(p, temperature=150.0, model=fm)
+    b = actuation_increments(turned, temperature=150.0, model=fm)
+    assert np.allclose(_turn(a.curvature, 3), b.curvature, rtol=0.0, atol=1e-12)
+    assert np.allclose(a.twist, b.twist, rtol=0.0, atol=1e-12)
+    assert np.allclose(a.stretch, b.stretch, rtol=0.0, atol=1e-12)

@@ -46,7 +46,7 @@ from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 
-from rotomorph._typing import IntArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
@@ -302,27 +302,52 @@ def _line_stencils(lm: LatticeModel) -> list[tuple[int, IntArray, IntArray, IntA
     return cache[key]  # type: ignore[no-any-return]
 
 
-def _same_program(a: Any, b: Any) -> bool:
-    """Whether print programs ``a`` and ``b`` differ at most by a translation (to round-off).
+def _program_turns(a: Any, b: Any) -> int | None:
+    """Quarter turns ``k`` about +z with which print program ``b`` is program ``a`` turned by
+    ``k π/2`` and moved (to round-off), or None.
 
-    Every input of :func:`~rotomorph.materials.natural.actuation_increments` is then equal:
-    the increments depend on the points only through their differences, and on the speeds,
-    nozzle angles and scalar settings themselves. Round-off is the 1e-12 relative tolerance
-    (lines laid out at different offsets differ by a few 1e-16 of their extent).
+    The actuation increments of :func:`~rotomorph.materials.natural.actuation_increments` then
+    follow: they depend on the points only through their differences, the nozzle angle only
+    relative to the path's heading (the lab nozzle angle turns with the path), the first
+    reference director is +z for a path in the plane, and the speeds and scalar settings are
+    equal; so ``b``'s curvature vectors are ``a``'s turned by ``k π/2`` (exact in floating
+    point: coordinates swapped and negated) and its eigen-twists and stretches are ``a``'s.
+    Round-off is the 1e-12 relative tolerance (lines laid out at different offsets differ by a
+    few 1e-16 of their extent).
     """
     if any(getattr(a, f) != getattr(b, f) for f in _PROGRAM_SCALARS):
-        return False
+        return None
     pa, pb = np.asarray(a.points, dtype=float), np.asarray(b.points, dtype=float)
-    if pa.shape != pb.shape:
-        return False
-    scale = 1.0 + float(np.abs(pa - pa[0]).max(initial=0.0))
-    if not np.allclose(pa - pa[0], pb - pb[0], rtol=0.0, atol=1e-12 * scale):
-        return False
-    for f in ("speed", "nozzle_angle"):
-        u, v = np.asarray(getattr(a, f), dtype=float), np.asarray(getattr(b, f), dtype=float)
-        if u.shape != v.shape or not np.allclose(u, v, rtol=1e-12, atol=1e-12):
-            return False
-    return True
+    sa = np.asarray(a.speed, dtype=float)
+    sb = np.asarray(b.speed, dtype=float)
+    na = np.asarray(a.nozzle_angle, dtype=float)
+    nb = np.asarray(b.nozzle_angle, dtype=float)
+    if pa.shape != pb.shape or sa.shape != sb.shape or na.shape != nb.shape:
+        return None
+    if not np.allclose(sa, sb, rtol=1e-12, atol=1e-12):
+        return None
+    da, db = pa - pa[0], pb - pb[0]
+    scale = 1.0 + float(np.abs(da).max(initial=0.0))
+    for k in range(4):
+        if not np.allclose(_turn(da, k), db, rtol=0.0, atol=1e-12 * scale):
+            continue
+        angle = 1.0 + float(np.abs(na).max(initial=0.0))
+        if np.allclose(na + k * 0.5 * np.pi, nb, rtol=0.0, atol=1e-12 * angle):
+            return k
+    return None
+
+
+def _turn(v: FloatArray, k: int) -> FloatArray:
+    """Vectors ``(..., 3)`` turned by ``k`` quarter turns about +z (exact)."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    k %= 4
+    if k == 0:
+        return v
+    if k == 1:
+        return np.stack([-y, x, z], axis=-1)
+    if k == 2:
+        return np.stack([-x, -y, z], axis=-1)
+    return np.stack([y, -x, z], axis=-1)
 
 
 #: scalar fields of a print program that must match exactly for two lines to share increments
@@ -335,22 +360,26 @@ _PROGRAM_SCALARS = (
 )
 
 
-def _program_groups(lm: LatticeModel) -> list[int]:
-    """Per printed line, the first line whose print program equals it up to a translation
-    (:func:`_same_program`): lines of a lattice laid out at a pitch repeat their program, and
-    the actuation increments of a program are computed once per temperature."""
+def _program_groups(lm: LatticeModel) -> list[tuple[int, int]]:
+    """Per printed line, ``(rep, k)``: the first line whose print program it equals turned by
+    ``k`` quarter turns about +z and moved (:func:`_program_turns`). The lines of a lattice
+    repeat their program at a pitch and, from x- to y-lines, turned by a quarter turn, so the
+    actuation increments of one program per group are computed per temperature."""
     key = ("program_groups",)
     cache = lm.lattice._cache
     if key not in cache:
         programs = [p for p, _ in lm.lattice.line_programs()]
         reps: list[int] = []
-        out = []
-        for k, prog in enumerate(programs):
-            rep = next((r for r in reps if _same_program(programs[r], prog)), None)
-            if rep is None:
-                reps.append(k)
-                rep = k
-            out.append(rep)
+        out: list[tuple[int, int]] = []
+        for line, prog in enumerate(programs):
+            for rep in reps:
+                turns = _program_turns(programs[rep], prog)
+                if turns is not None:
+                    out.append((rep, turns))
+                    break
+            else:
+                reps.append(line)
+                out.append((line, 0))
         cache[key] = out
     return cache[key]  # type: ignore[no-any-return]
 
@@ -373,8 +402,8 @@ class ProgramActuation:
     increments are the frame-free output of
     :func:`~rotomorph.materials.natural.actuation_increments`, read in the lattice model's
     frames with :func:`rotomorph.geometry.curvature_increment`, exactly as a single filament
-    reads them in its own. Lines whose programs differ only by a translation
-    (:func:`_same_program`) share one evaluation per temperature.
+    reads them in its own. Lines whose programs differ only by a translation and a quarter
+    turn about +z (:func:`_program_turns`) share one evaluation per temperature.
     """
 
     start: float = 25.0
@@ -397,13 +426,13 @@ class ProgramActuation:
         groups = _program_groups(lm)
         increments: dict[int, ActuationIncrements] = {}  # one per distinct program
         for line, rows, stencils, line_edges, model_edges in _line_stencils(lm):
-            rep = groups[line]
+            rep, turns = groups[line]
             if rep not in increments:
                 increments[rep] = actuation_increments(
                     programs[rep][0], temperature=float(parameter), model=fm
                 )
             inc = increments[rep]
-            vec[stencils] = inc.curvature[rows]
+            vec[stencils] = _turn(inc.curvature[rows], turns)
             twist[stencils] = inc.twist[rows]
             stretch[model_edges] = inc.stretch[line_edges]
         x = model.network.nodes
