@@ -232,3 +232,19 @@ def test_path_check_reusing_the_step_candidates_decides_as_a_fresh_one(rng):
             checks += 1
     assert any(verdicts) and not all(verdicts)  # both verdicts were exercised
     assert builds[0] < 60 + checks / 2  # most checks reused the step's candidates
+
+
+def test_excluded_pairs_are_remembered_per_network_and_settings():
+    """The solves of a ramp bind the same network once per step: its excluded pairs are
+    computed once per settings and equal a fresh computation."""
+    from rotomorph.contact.exclusion import excluded_pairs
+
+    model, _ = _filament(1.2 * R, n=41)
+    net = model.network
+    a = ContactPotential(Contact(R), net)
+    b = ContactPotential(Contact(R), net)
+    assert a.excluded is b.excluded
+    fresh = excluded_pairs(net.nodes, np.asarray(net.edges, np.int64), a.radius, a.dhat)
+    assert np.array_equal(a.excluded, fresh) and len(fresh)
+    wider = ContactPotential(Contact(R, reach=4.0 * R), net)
+    assert wider.excluded is not a.excluded and len(wider.excluded) > len(a.excluded)

@@ -17,6 +17,7 @@ is exact).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -193,7 +194,7 @@ class ContactPotential:
         self.dhat = float(contact.activation_distance or DEFAULT_ACTIVATION * dmin_small)
         self.slip = float(contact.slip or 1e-3 * dmin_small)
         self.excluded = (
-            excluded_pairs(network.nodes, edges, self.radius, self.dhat, contact.reach)
+            _excluded(network, edges, self.radius, self.dhat, contact.reach)
             if contact.self_contact
             else np.zeros(0, dtype=np.int64)
         )
@@ -601,6 +602,23 @@ class ContactPotential:
                 f"{d[k]:.4g} mm < {dmin[k]:.4g} mm); start from a separated configuration, move "
                 "the obstacles away, or widen Contact.reach",
             )
+
+
+#: excluded pairs per network (a frozen value) and contact settings: the solves of a heating
+#: ramp bind the same network once per step
+_EXCLUDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _excluded(
+    network: Network, edges: IntArray, radius: FloatArray, dhat: float, reach: float | None
+) -> IntArray:
+    """:func:`~rotomorph.contact.exclusion.excluded_pairs` of ``network``, remembered per
+    network and settings (shared: never written to)."""
+    per = _EXCLUDED.setdefault(network, {})
+    key = (radius.tobytes(), float(dhat), reach)
+    if key not in per:
+        per[key] = excluded_pairs(network.nodes, edges, radius, dhat, reach)
+    return per[key]  # type: ignore[no-any-return]
 
 
 def _tangent_basis(normal: FloatArray) -> FloatArray:
