@@ -64,6 +64,17 @@ def test_straight_limit_is_the_straight_section(section) -> None:  # type: ignor
     assert np.array_equal(curved[0], straight[0]) and np.array_equal(curved[1], straight[1])
 
 
+def test_anisotropic_uniform_eigenstrain_turns_by_the_metric(section) -> None:  # type: ignore[no-untyped-def]
+    # fibres all shorten by 1 + e_par while the section widens by 1 + e_t: the bar turns
+    # through (1 + e_par)/(1 + e_t) times its printed angle, 1 + e_par - e_t to first order
+    ax = section.axial
+    e_par, e_t = -0.2, 0.1
+    k0 = np.array([[1.2, -0.5]])
+    eps = np.full((1, len(ax.points)), e_par)
+    _, dk = ax.natural_curved(eps, k0, np.array([e_t]))
+    assert np.allclose(k0 + dk, k0 * (1 + e_par - e_t), rtol=1e-12)
+
+
 @pytest.mark.parametrize("k0", [(2.0, 0.0), (-1.0, 2.2)])
 def test_uniform_isotropic_eigenstrain_is_a_similarity(section, k0) -> None:  # type: ignore[no-untyped-def]
     ax = section.axial
@@ -105,6 +116,19 @@ def test_printed_curvature_of_a_circle_and_a_sharp_corner(section, caplog) -> No
     corner = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.1, 0.0]])
     with caplog.at_level(logging.WARNING, logger="rotomorph.materials.natural"):
         k = printed_curvature(SimpleNamespace(points=corner), section)
-    extent = section.radius + np.linalg.norm(section.axial.centroid)
-    assert np.linalg.norm(k[0]) * extent == pytest.approx(CURVATURE_LIMIT)
+    assert np.linalg.norm(k[0]) * section.radius == pytest.approx(CURVATURE_LIMIT)
     assert "sharply" in caplog.text
+
+
+def test_curved_states_survive_a_full_straight_memory(section, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    # solving the straight rows of a batch may clear the straight states' memory; the curved
+    # states are remembered apart, so a large mixed call still finds every one of its rows
+    import rotomorph.materials.janus as janus
+
+    monkeypatch.setattr(janus, "SOLVED_STATES_LIMIT", 700)
+    n = 1200
+    k0 = np.zeros((n, 2))
+    k0[1::2, 0] = np.linspace(0.1, 2.0, n // 2)
+    eps_par = np.linspace(-0.3, -0.1, n)
+    eps_c, dk = section.curved_strains(0.0, eps_par, 0.1, 0.02, k0)
+    assert eps_c.shape == (n,) and dk.shape == (n, 2) and np.all(np.isfinite(dk))

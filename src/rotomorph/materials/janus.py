@@ -72,6 +72,9 @@ class FilamentSection:
     _solved: dict[bytes, FloatArray] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+    _curved: dict[bytes, FloatArray] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def solved_states(self) -> int:
@@ -169,7 +172,7 @@ class FilamentSection:
         :meth:`rotomorph.materials.section.AxialSection.natural_curved`, with the section's
         mean transverse eigenstrain from Turner's rule (the modulus-weighted mean of the phases'
         in-plane eigenstrains; Turner, J. Res. NBS 37, 239 (1946)). Equal to
-        :meth:`natural_strains` plus the printed curvature where the curvature is 0.
+        :meth:`natural_strains`' (ε_c, κ̄) where the printed curvature is 0.
         """
         cols = np.broadcast_arrays(
             *(np.atleast_1d(np.asarray(a, dtype=float)) for a in
@@ -180,15 +183,16 @@ class FilamentSection:
         table = np.column_stack([*cols, k0]) + 0.0
         states, inverse = unique_rows(table)
         keys = [row.tobytes() for row in states]
-        missing = [i for i, key in enumerate(keys) if key not in self._solved]
-        if len(self._solved) + len(missing) > SOLVED_STATES_LIMIT:
-            self._solved.clear()
+        # their own memory: solving straight rows below may clear the straight states' one
+        missing = [i for i, key in enumerate(keys) if key not in self._curved]
+        if len(self._curved) + len(missing) > SOLVED_STATES_LIMIT:
+            self._curved.clear()
             missing = list(range(len(keys)))
         for lo in range(0, len(missing), _BATCH):
             batch = missing[lo : lo + _BATCH]
             solved = self._solve_curved(states[batch])
-            self._solved.update(zip((keys[i] for i in batch), solved, strict=True))
-        out = np.array([self._solved[key] for key in keys]).reshape(len(keys), 3)[inverse]
+            self._curved.update(zip((keys[i] for i in batch), solved, strict=True))
+        out = np.array([self._curved[key] for key in keys]).reshape(len(keys), 3)[inverse]
         return out[:, 0], out[:, 1:3]
 
     def _solve_curved(self, states: FloatArray) -> FloatArray:

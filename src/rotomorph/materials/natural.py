@@ -461,9 +461,8 @@ def _vertex_increments(
     return vec, np.asarray(dtau, dtype=float).reshape(-1), deps
 
 
-#: Largest ``|k0| (R + |c|)`` the curved-section theory is applied with (a printed corner
-#: sharper than the filament is a polyline artefact: no extruded filament bends tighter than
-#: its size).
+#: Largest ``|k0| R`` the curved-section theory is applied with (a printed corner sharper than
+#: the filament is a polyline artefact: no extruded filament bends tighter than its radius).
 CURVATURE_LIMIT = 0.9
 
 
@@ -471,8 +470,10 @@ def printed_curvature(program: Any, section: FilamentSection) -> FloatArray:
     """Printed pointwise curvature vectors ``(N-2, 3)`` (1/mm, toward the centre of curvature)
     at the interior vertices of ``program``'s path, for the curved-section correction.
 
-    Vertices whose curvature radius is below the section's extent (a sharp polyline corner)
-    are limited to :data:`CURVATURE_LIMIT` of it, with a warning.
+    Vertices whose curvature radius is below the filament radius R (a sharp polyline corner)
+    are limited to ``|k0| R =`` :data:`CURVATURE_LIMIT`, with a warning: there the correction
+    depends on the vertex spacing (a corner's curvature is its turning angle over the
+    spacing), so paths with corners should be rounded to at least the filament radius.
     """
     pts = np.asarray(program.points, dtype=float)
     e = np.diff(pts, axis=0)
@@ -481,8 +482,7 @@ def printed_curvature(program: Any, section: FilamentSection) -> FloatArray:
     vor = 0.5 * (lengths[:-1] + lengths[1:])
     tb = geometry.unit(e[:-1] / lengths[:-1, None] + e[1:] / lengths[1:, None])
     k0 = np.cross(kb, tb) / vor[:, None]
-    extent = section.radius + float(np.linalg.norm(section.axial.centroid))
-    size = np.linalg.norm(k0, axis=1) * extent
+    size = np.linalg.norm(k0, axis=1) * section.radius
     sharp = size > CURVATURE_LIMIT
     if np.any(sharp):
         logger.warning(

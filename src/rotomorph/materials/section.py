@@ -116,24 +116,32 @@ class AxialSection:
         lies on that side) along its geometric centre line has fibres of reference length
         ∝ 1 − k0·x (x from the geometric centre, the nozzle's axis): fibres on the inner side
         are shorter (Winkler's curved bar; e.g. Boresi & Schmidt, *Advanced Mechanics of
-        Materials*, 6th ed., Wiley 2003, ch. 9). With plane sections, a fibre's strain is
-        (ε_g − Δκ·x − ε̄_t k0·x)/(1 − k0·x), ε_g that of the geometric centre, Δκ the change
-        of turning per printed length and ε̄_t x the section's own in-plane dilation (its mean
-        transverse eigenstrain; with a uniform isotropic eigenstrain the bar changes by a
-        similarity, Δκ = 0). Minimising ½∫E(ε − ε*)²(1 − k0·x) dA gives, with
-        w = E/(1 − k0·x) and g = Δκ + ε̄_t k0,
+        Materials*, 6th ed., Wiley 2003, ch. 9). The section itself dilates in its plane by its
+        mean transverse eigenstrain ε̄_t, so a fibre at x ends at (1 + ε̄_t) x. With plane
+        sections and natural turning K = k0 + Δκ per printed length, a fibre's strain is
+        (ε_g − g·x)/(1 − k0·x) with g = Δκ + ε̄_t k0 and ε_g that of the geometric centre,
+        to first order in the strains and exactly in k0·x (the product ε̄_t Δκ is dropped, as
+        the straight bar drops ε̄_t κ). Minimising ½∫E(ε − ε*)²(1 − k0·x) dA gives, with
+        w = E/(1 − k0·x),
 
         .. math::
 
             \begin{pmatrix}∫w & −∫w\,x^T \\ −∫w\,x & ∫w\,x x^T\end{pmatrix}
             \begin{pmatrix}ε_g \\ g\end{pmatrix}
-            = \begin{pmatrix}∫E ε^* \\ −∫E ε^* x\end{pmatrix};
+            = \begin{pmatrix}∫E ε^* \\ −∫E ε^* x\end{pmatrix},
 
-        the natural strain returned is that of the fibre at the modulus-weighted centroid c,
-        (ε_g − g·c)/(1 − k0·c), as :meth:`natural_strain` (to which, with
-        :meth:`natural_curvature`, the result reduces for k0 = 0). The weights make a
-        contracting phase on the inner side (shorter fibres) bend the bar less, and one on the
-        outer side more, than on a straight bar, by a relative amount of order k0 R.
+        and Δκ = g − ε̄_t k0. The natural strain returned is that of the fibre at the
+        modulus-weighted centroid c, (ε_g − g·c)/(1 − k0·c), as :meth:`natural_strain` (to
+        which, with :meth:`natural_curvature`, the result reduces for k0 = 0).
+
+        Two effects make the change differ from the straight bar's. The larger is metric: a
+        curved bar whose fibres shorten by ε along it while the section widens by ε̄_t turns
+        through (1 + ε)/(1 + ε̄_t) times its printed angle, 1 + ε − ε̄_t here to first order
+        (a uniform isotropic eigenstrain gives a similarity, Δκ = 0; an LCE contracting along
+        the bar and swelling across it turns less). The smaller is Winkler's weighting of the
+        shorter inner fibres. For a Janus section the two together make an active half on the
+        inner side curl less, and one on the outer side straighten more, than on a straight
+        bar.
 
         Parameters
         ----------
@@ -176,8 +184,8 @@ class AxialSection:
         sol = np.linalg.solve(m, rhs[..., None])[..., 0]
         eps_g, g = sol[..., 0], sol[..., 1:]
         eps_c = (eps_g - g @ self.centroid) / (1.0 - k0 @ self.centroid)
-        t = np.asarray(transverse, dtype=float)
-        return eps_c, g - t[..., None] * k0
+        t = np.asarray(transverse, dtype=float)[..., None]
+        return eps_c, g - t * k0
 
 
 def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> AxialSection:
