@@ -151,3 +151,27 @@ def test_a_changed_speed_shape_or_nozzle_is_not_the_same_program() -> None:
     assert np.allclose(_turn(a.curvature, 3), b.curvature, rtol=0.0, atol=1e-12)
     assert np.allclose(a.twist, b.twist, rtol=0.0, atol=1e-12)
     assert np.allclose(a.stretch, b.stretch, rtol=0.0, atol=1e-12)
+
+
+def test_programs_with_remembered_attributes_give_the_same_field_bit_for_bit() -> None:
+    """The ramp reads each line program's derived attributes once (``_Derived``): the natural
+    field is bit for bit the one from the programs themselves, handed-out arrays are copies,
+    and an attribute the program lacks is still missing (``getattr`` defaults apply)."""
+    from rotomorph.lattice.actuation import _Derived
+
+    fm = FilamentModel(resolution=16)
+    lat = sinusoidal_lattice(3, 5.0, 1.25, 6, "saddle")
+    lm = lattice_model(lat, stiffness="janus", filament_model=fm)
+    act = ProgramActuation(filament_model=fm)
+    remembered = [act.natural(lm, t) for t in (120.0, 150.0)]
+    lat._cache[("derived_programs",)] = [p for p, _ in lat.line_programs()]
+    plain = [act.natural(lm, t) for t in (120.0, 150.0)]
+    for a, b in zip(remembered, plain, strict=True):
+        for name in ("natural_curvature1", "natural_curvature2", "natural_twist", "rest_length"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    program = lat.line_programs()[0][0]
+    derived = _Derived(program)
+    first = derived.interface_angle
+    first[:] = 0.0
+    assert np.array_equal(derived.interface_angle, program.interface_angle)
+    assert getattr(derived, "no_such_attribute", "default") == "default"

@@ -384,6 +384,41 @@ def _program_groups(lm: LatticeModel) -> list[tuple[int, int]]:
     return cache[key]  # type: ignore[no-any-return]
 
 
+class _Derived:
+    """A print program whose attributes are computed once.
+
+    Several attributes of :class:`~rotomorph.design.program.PrintProgram` (``rotation``,
+    ``interface_angle``, ``director_rotation``, ``vertex_interface_normals``) are recomputed
+    from its arrays on every access, about 4 ms per evaluation of a lattice line, and a ramp
+    asks for them at every temperature. The program is a value, so each attribute is taken
+    from it once, on first access (an absent one raises ``AttributeError`` as on the program,
+    so ``getattr`` defaults still apply), and arrays are handed out as copies: the increments
+    are bit for bit those of the program itself.
+    """
+
+    __slots__ = ("_memo", "_program")
+
+    def __init__(self, program: Any) -> None:
+        self._program = program
+        self._memo: dict[str, Any] = {}
+
+    def __getattr__(self, name: str) -> Any:
+        memo = self._memo
+        if name not in memo:
+            memo[name] = getattr(self._program, name)
+        value = memo[name]
+        return value.copy() if isinstance(value, np.ndarray) else value
+
+
+def _derived_programs(lm: LatticeModel) -> list[_Derived]:
+    """:class:`_Derived` of every printed line (remembered with the lattice)."""
+    key = ("derived_programs",)
+    cache = lm.lattice._cache
+    if key not in cache:
+        cache[key] = [_Derived(p) for p, _ in lm.lattice.line_programs()]
+    return cache[key]  # type: ignore[no-any-return]
+
+
 @dataclass(frozen=True)
 class ProgramActuation:
     """Default mode: each printed line's natural field from its print program at T (°C).
@@ -422,14 +457,14 @@ class ProgramActuation:
         vec = np.zeros((st.count, 3))
         twist = np.zeros(st.count)
         stretch = np.ones(model.network.n_edges)
-        programs = lm.lattice.line_programs()
+        programs = _derived_programs(lm)
         groups = _program_groups(lm)
         increments: dict[int, ActuationIncrements] = {}  # one per distinct program
         for line, rows, stencils, line_edges, model_edges in _line_stencils(lm):
             rep, turns = groups[line]
             if rep not in increments:
                 increments[rep] = actuation_increments(
-                    programs[rep][0], temperature=float(parameter), model=fm
+                    programs[rep], temperature=float(parameter), model=fm
                 )
             inc = increments[rep]
             vec[stencils] = _turn(inc.curvature[rows], turns)
