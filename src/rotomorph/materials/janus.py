@@ -16,6 +16,7 @@ distort the section and are ignored by rod theory.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -145,17 +146,8 @@ class FilamentSection:
             *(np.atleast_1d(np.asarray(a, dtype=float)) for a in
               (omega_star, eps_parallel, eps_perpendicular, eps_passive))
         )  # fmt: skip
-        states, inverse = unique_rows(np.column_stack(cols) + 0.0)
-        keys = [row.tobytes() for row in states]
-        missing = [i for i, key in enumerate(keys) if key not in self._solved]
-        if len(self._solved) + len(missing) > SOLVED_STATES_LIMIT:
-            self._solved.clear()
-            missing = list(range(len(keys)))
-        for lo in range(0, len(missing), _BATCH):
-            batch = missing[lo : lo + _BATCH]
-            solved = self._solve_states(states[batch])
-            self._solved.update(zip((keys[i] for i in batch), solved, strict=True))
-        table = np.array([self._solved[key] for key in keys]).reshape(len(keys), 4)[inverse]
+        table = _remembered(np.column_stack(cols), self._solved, self._solve_states)
+        table = table.reshape(-1, 4)
         return table[:, 0], table[:, 1:3], table[:, 3]
 
     def curved_strains(
@@ -180,19 +172,9 @@ class FilamentSection:
         )  # fmt: skip
         k0 = np.asarray(curvature, dtype=float).reshape(-1, 2)
         cols = np.broadcast_arrays(*cols, k0[:, 0])[:4]
-        table = np.column_stack([*cols, k0]) + 0.0
-        states, inverse = unique_rows(table)
-        keys = [row.tobytes() for row in states]
-        # their own memory: solving straight rows below may clear the straight states' one
-        missing = [i for i, key in enumerate(keys) if key not in self._curved]
-        if len(self._curved) + len(missing) > SOLVED_STATES_LIMIT:
-            self._curved.clear()
-            missing = list(range(len(keys)))
-        for lo in range(0, len(missing), _BATCH):
-            batch = missing[lo : lo + _BATCH]
-            solved = self._solve_curved(states[batch])
-            self._curved.update(zip((keys[i] for i in batch), solved, strict=True))
-        out = np.array([self._curved[key] for key in keys]).reshape(len(keys), 3)[inverse]
+        # their own memory: solving straight rows may clear the straight states' one
+        out = _remembered(np.column_stack([*cols, k0]), self._curved, self._solve_curved)
+        out = out.reshape(-1, 3)
         return out[:, 0], out[:, 1:3]
 
     def _solve_curved(self, states: FloatArray) -> FloatArray:
@@ -223,6 +205,23 @@ class FilamentSection:
                 self.torsion.natural_twist(gamma),
             ]
         )
+
+
+def _remembered(
+    table: FloatArray, memory: dict[bytes, FloatArray], solve: Callable[[FloatArray], FloatArray]
+) -> FloatArray:
+    """``solve`` of every row of ``table``, each distinct row (exact key, +0.0 for -0.0) solved
+    once and kept in ``memory`` (cleared when it would pass :data:`SOLVED_STATES_LIMIT`)."""
+    states, inverse = unique_rows(table + 0.0)
+    keys = [row.tobytes() for row in states]
+    missing = [i for i, key in enumerate(keys) if key not in memory]
+    if len(memory) + len(missing) > SOLVED_STATES_LIMIT:
+        memory.clear()
+        missing = list(range(len(keys)))
+    for lo in range(0, len(missing), _BATCH):
+        batch = missing[lo : lo + _BATCH]
+        memory.update(zip((keys[i] for i in batch), solve(states[batch]), strict=True))
+    return np.array([memory[key] for key in keys])[inverse]
 
 
 @lru_cache(maxsize=16)
