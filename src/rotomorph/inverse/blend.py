@@ -58,6 +58,7 @@ from rotomorph.materials.natural import (
     DIRECTOR_HELIX_SENSE,
     FilamentModel,
     actuation_increments,
+    edge_shares,
 )
 from rotomorph.rod.model import Model
 
@@ -68,30 +69,18 @@ _REL_STEP = 1e-6
 
 @dataclass(frozen=True)
 class _MarkedStrains:
-    """A strain law giving (ε∥, ε⊥) at the speed ``marker`` and zero at any other speed: the
-    unit responses of the vertices printed at that speed."""
+    """A strain law giving (ε∥, ε⊥) at the speed ``marker`` (every speed when ``None``) and zero
+    at any other speed: the unit responses of the vertices printed at that speed."""
 
     parallel: float
     perpendicular: float
-    marker: float
+    marker: float | None
     measure: Any
 
     def active_strains(self, speed: Any) -> tuple[FloatArray, FloatArray]:
-        hit = np.asarray(speed, dtype=float) == self.marker
+        u = np.asarray(speed, dtype=float)
+        hit = np.ones(u.shape, dtype=bool) if self.marker is None else u == self.marker
         return np.where(hit, self.parallel, 0.0), np.where(hit, self.perpendicular, 0.0)
-
-
-@dataclass(frozen=True)
-class _UnitStrains:
-    """A strain law giving the same (ε∥, ε⊥) at every speed: unit responses."""
-
-    parallel: float
-    perpendicular: float
-    measure: Any
-
-    def active_strains(self, speed: Any) -> tuple[FloatArray, FloatArray]:
-        shape = np.shape(speed)
-        return np.full(shape, self.parallel), np.full(shape, self.perpendicular)
 
 
 @dataclass(frozen=True, eq=False)
@@ -553,20 +542,16 @@ def _segment_curved(lattice: Lattice, fm: FilamentModel, temperature: float) -> 
     n_edges = len(lattice.edge_chains)
     measure = fm.strain_model.measure
     laws = [
-        replace(fm, strain_model=_UnitStrains(1.0, 0.0, measure), passive_strain=0.0),
-        replace(fm, strain_model=_UnitStrains(0.0, 1.0, measure), passive_strain=0.0),
-        replace(fm, strain_model=_UnitStrains(0.0, 0.0, measure), passive_strain=1.0),
+        replace(fm, strain_model=_MarkedStrains(1.0, 0.0, None, measure), passive_strain=0.0),
+        replace(fm, strain_model=_MarkedStrains(0.0, 1.0, None, measure), passive_strain=0.0),
+        replace(fm, strain_model=_MarkedStrains(0.0, 0.0, None, measure), passive_strain=1.0),
     ]
     for m, sign in enumerate((1.0, -1.0)):
         lat = with_settings(lattice, np.full(n_edges, sign), lattice.speeds)
         for q, law in enumerate(laws):
             for prog, segs in lat.line_programs():
                 deps = actuation_increments(prog, temperature=temperature, model=law).curved_strain
-                n = len(segs)
-                count = np.full(n, 2.0)
-                count[0] = count[-1] = 1.0
-                out[segs[1:], 0, m, q] = deps / count[1:]  # vertex j is segment j's start
-                out[segs[:-1], 1, m, q] = deps / count[:-1]  # and segment j-1's end
+                out[segs, 0, m, q], out[segs, 1, m, q] = edge_shares(deps)
     return out
 
 

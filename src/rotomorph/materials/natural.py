@@ -532,6 +532,19 @@ def _step_flip_normals(
     return out
 
 
+def edge_shares(vertex_values: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Each edge's shares ``(N-1,)`` of interior-vertex values ``(N-2,)``, from its start and
+    from its end vertex: their sum is the mean over the edge's interior end vertices (one for
+    the first and last edge)."""
+    v = np.asarray(vertex_values, dtype=float)
+    count = np.full(len(v) + 1, 2.0)
+    count[0] = count[-1] = 1.0
+    start, end = np.zeros(len(v) + 1), np.zeros(len(v) + 1)
+    start[1:] = v / count[1:]  # vertex j is edge j's start
+    end[:-1] = v / count[:-1]  # and edge j-1's end
+    return start, end
+
+
 @dataclass(frozen=True, eq=False)
 class ActuationIncrements:
     """What heating adds to the printed natural state of one filament (frame-free form).
@@ -616,12 +629,8 @@ def actuation_increments(
     )
     measure = model.strain_model.measure
     # the curved-section change of the centre-line strain, from the edge's interior end(s)
-    ends = np.zeros((2, len(t)))
-    ends[0, 1:] = deps
-    ends[1, :-1] = deps
-    count = np.full(len(t), 2.0)
-    count[0] = count[-1] = 1.0
-    axial = np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t)) + ends.sum(0) / count
+    from_start, from_end = edge_shares(deps)
+    axial = np.asarray(eps_c, dtype=float).reshape(-1) * np.ones(len(t)) + from_start + from_end
     stretch = np.exp(axial) if measure == "hencky" else 1.0 + axial
     return ActuationIncrements(
         curvature=vec,
