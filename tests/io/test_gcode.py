@@ -49,8 +49,10 @@ def _assert_same(read, progs, tol=1e-6):
         np.testing.assert_allclose(q.points, p.points, atol=tol)
         turns = np.round((q.nozzle_angle[0] - p.nozzle_angle[0]) / (2 * np.pi))
         # the angle follows the design's dα/ds along the *written* (rounded) lengths, so it may
-        # drift from the design's floats by the rounding of the lengths: ~1e-6 of the angle
-        drift = tol * (1 + np.ptp(p.nozzle_angle))
+        # drift from the design's floats by the rounding of the lengths: each edge's turn times
+        # the coordinates' rounding (~tol mm) over its length
+        lengths = np.linalg.norm(np.diff(p.points, axis=0), axis=1)
+        drift = tol * (1 + np.sum(np.abs(np.diff(p.nozzle_angle)) / np.minimum(lengths, 1.0)))
         np.testing.assert_allclose(q.nozzle_angle - 2 * np.pi * turns, p.nozzle_angle, atol=drift)
         np.testing.assert_allclose(q.speed[:-1], p.speed[:-1], rtol=1e-9)
         assert (q.radius, q.active_fraction, q.layer) == (p.radius, p.active_fraction, p.layer)
