@@ -83,8 +83,10 @@ def test_pure_lce_arc_turns_by_its_metric_not_by_its_shrinkage():
     # section gives it to first order, θ (1 + ε∥ − ε⊥)). An earlier bug multiplied the
     # per-length curvature by the shortened length instead, θ e^ε∥: 1.5 -> 1.197 rad.
     path = Path.from_segments([Arc(4.0, 1.5)], spacing=0.05)
-    # a nozzle that does not rotate: no director helix, hence no eigen-twist
-    program = PrintProgram.from_rotation(path, 3.0, 0.0, active_fraction=1.0)
+    # a nozzle that turns with the heading (constant interface angle): no director helix,
+    # hence no eigen-twist
+    program = PrintProgram.from_interface_angle(path, 3.0, 0.0, active_fraction=1.0)
+    assert np.allclose(program.director_rotation, 0.0)
     fm = FilamentModel()
     field = natural_field(program, temperature=175.0, model=fm)
     assert np.all(field.axial_strain < -0.1)  # the LCE contracts along its director

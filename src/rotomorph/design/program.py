@@ -201,20 +201,28 @@ class PrintProgram:
 
     @property
     def director_rotation(self) -> FloatArray:
-        """Nozzle rotation rate that winds the director helix, per vertex ``(N,)`` (rad/s).
+        """Rotation rate that winds the director helix, per vertex ``(N,)`` (rad/s).
 
-        :attr:`rotation`, except with ``step_flips``: the ideal flips (interface-angle
-        changes of π/2 or more over one edge) have zero length, so their rotation winds no
-        helix; there the nozzle counts as only tracking the heading.
+        The nozzle's rotation *relative to the path heading*, v d(α_n − ψ)/ds = −v dα/ds: the
+        ink leaves the nozzle turning with it, and the extrudate between the nozzle and the
+        deposited filament is twisted only by the part of that turn the filament's own frame
+        does not share. The interface is a material surface, so every material line of the
+        section winds around the filament at the interface's rate dα/ds, and the shear-aligned
+        director follows the material lines (the paper's ω = v dα/ds, φ = atan ω*). On a
+        straight path this is :attr:`rotation`; a nozzle that only tracks the heading of a
+        curved path (the active half kept on one side) winds no helix. With ``step_flips``
+        the ideal flips (interface-angle changes of π/2 or more over one edge) have zero
+        length and wind none either.
         """
-        if not self.step_flips:
-            return self.rotation
         psi = _vertex_heading(self.path)
-        d_noz = np.diff(self.nozzle_angle)
-        d_alpha = np.diff(psi) - d_noz
-        flip = np.abs(d_alpha) >= 0.5 * np.pi - 1e-9
-        smooth = np.concatenate([[0.0], np.cumsum(np.where(flip, np.diff(psi), d_noz))])
-        return self.speed * np.gradient(smooth, self.arc_length)
+        d_rel = np.diff(self.nozzle_angle - psi)
+        # a nozzle that tracks the heading leaves round-off here, not a rotation (exact zeros
+        # also let the section remember one print state for all of those vertices)
+        d_rel = np.where(np.abs(d_rel) < 1e-12, 0.0, d_rel)
+        if self.step_flips:
+            d_rel = np.where(np.abs(d_rel) >= 0.5 * np.pi - 1e-9, 0.0, d_rel)
+        relative = np.concatenate([[0.0], np.cumsum(d_rel)])
+        return self.speed * np.gradient(relative, self.arc_length)
 
     @property
     def rotation_number(self) -> FloatArray:
