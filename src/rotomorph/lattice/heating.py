@@ -31,7 +31,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.area import lattice_boundary_loop, normalized_area
 from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.analysis.shape import edge_end_to_end_ratios, end_to_end_ratio
-from rotomorph.contact import Contact, Floor
+from rotomorph.contact import Contact, Floor, InfeasibleContactError
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidParameterError
 from rotomorph.geometry import parallel_transport, unit
@@ -48,6 +48,7 @@ from rotomorph.rod.state import State
 from rotomorph.solve.continuation import continuation
 from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.stability import stability
 from rotomorph.solve.static import StaticResult, solve_static
 
 __all__ = [
@@ -74,14 +75,14 @@ SupportsName = Literal["free", "clamped-boundary", "pinned-centre"]
 phase_log = logging.getLogger("rotomorph.progress")
 
 
-def perturbed_state(model: Model, dz: FloatArray) -> State:
-    """The printed state with node heights raised by ``dz`` ``(N,)`` (mm).
+def perturbed_state(model: Model, dz: FloatArray, base: State | None = None) -> State:
+    """``base`` (default the printed state) with node heights raised by ``dz`` ``(N,)`` (mm).
 
     ``dz`` may also be a full displacement ``(N, 3)`` (mm). Tangents are recomputed, reference
-    directors parallel-transported from the printed tangents, twist angles zero and reference
-    twists unwrapped against the printed ones, so the material frames follow without twisting.
+    directors parallel-transported from the base tangents, twist angles kept and reference
+    twists unwrapped against the base ones, so the material frames follow without twisting.
     """
-    ref = model.reference_state()
+    ref = model.reference_state() if base is None else base
     dz = np.asarray(dz, dtype=float)
     n = model.network.n_nodes
     if dz.shape not in ((n,), (n, 3)) or not np.all(np.isfinite(dz)):
@@ -224,6 +225,11 @@ class HeatingResult:
         With contact: pairs and floor nodes carrying contact force at each step.
     floor_lift
         With a floor: the largest rise of a node above its printed height at each step (mm).
+    lift_energy_gap
+        With ``branch="lowest"`` on a floor under weight: total energy of the best lifted
+        equilibrium found minus that of the resting one at each step where the lattice rested
+        on the floor and its unsupported lowest mode was unstable (N mm; negative: the lifted
+        branch was taken); NaN where no lifted equilibrium was probed or found.
     """
 
     parameter: FloatArray
@@ -248,6 +254,7 @@ class HeatingResult:
     contact: Contact | None = None
     contacts_active: IntArray | None = None
     floor_lift: FloatArray | None = None
+    lift_energy_gap: FloatArray | None = None
 
     @property
     def final_area_ratio(self) -> float:
@@ -359,6 +366,7 @@ def heat_lattice(
     contact: bool | Contact = False,
     floor: bool | Floor = False,
     friction: float = 0.0,
+    branch: Literal["lowest", "continuous"] = "lowest",
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -402,6 +410,17 @@ def heat_lattice(
         (they are removed from every Newton step).
     friction
         Coulomb coefficient of every contact (lagged per ramp step; default 0).
+    branch
+        Which equilibrium a lattice resting on a floor under its weight follows.
+        ``"continuous"``: the one reached continuously from the previous step. On a rigid
+        floor under any weight a perfectly flat lattice never loses stability (lifting costs
+        weight × height to first order, the bending energy it releases is of second order), so
+        the resting state is left only where the barrier's finite stiffness gives way, late and
+        with a snap. ``"lowest"`` (default): at every step where the lattice still rests on the
+        floor and the unsupported lattice's lowest mode is unstable, also solve from lifted
+        starts along that mode and keep the equilibrium of lower total energy — the state an
+        imperfect real lattice, disturbed as it is moved into the hot bath, settles in
+        (:func:`_lift_probe`; ``lift_energy_gap`` records the comparison).
 
     Returns
     -------
@@ -410,7 +429,8 @@ def heat_lattice(
     Raises
     ------
     InvalidParameterError
-        Bad steps, perturbation, supports or stiffness option; gravity on a free lattice.
+        Bad steps, perturbation, supports, stiffness or branch option; gravity on a free
+        lattice.
     ConvergenceError
         A ramp step failed after ``max_halvings`` halvings (``error.result`` holds the steps
         reached).
@@ -442,9 +462,18 @@ def heat_lattice(
             "gravity on a free lattice needs a floor to rest on (floor=True) or a support "
             "('pinned-centre' or 'clamped-boundary')",
         )
+    if branch not in ("lowest", "continuous"):
+        raise InvalidParameterError("branch", f"must be 'lowest' or 'continuous'; got {branch!r}")
+    probe_floor = (
+        settings.floor
+        if branch == "lowest" and settings is not None and gravity is not None
+        else None
+    )
     values = np.linspace(act.start, act.end, int(steps) + 1)
 
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
+
+    probes: dict[float, float] = {}  # parameter -> energy of the lifted branch minus resting
 
     def solve(p: float, state: State) -> StaticResult:
         phase_log.info("natural field (%s) at %g", act.name, p)
@@ -456,7 +485,20 @@ def heat_lattice(
         except ConvergenceError as err:
             events.append((p, int(getattr(err.result, "iterations", 0)), False))
             raise
+        if probe_floor is not None:
+            assert settings is not None  # a floor implies contact settings
+            lifted, gap, its = _lift_probe(
+                model, sup, loads, settings, res, options, probe_floor, lattice
+            )
+            if its:
+                events.append((p, its, False))  # probe solves count toward this step
         events.append((p, res.iterations, True))
+        if probe_floor is not None:
+            if gap is not None:
+                probes[p] = gap
+            if lifted is not None and gap is not None:
+                phase_log.info("lifted branch at %g is lower by %.3g N mm", p, -gap)
+                res = lifted
         return res
 
     path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
@@ -510,7 +552,77 @@ def heat_lattice(
         contact=settings,
         contacts_active=active,
         floor_lift=lift,
+        lift_energy_gap=None
+        if probe_floor is None
+        else np.array([np.nan] + [probes.get(float(v), np.nan) for v in values[1:]]),
     )
+
+
+#: Height of the lifted starts of :func:`_lift_probe`, in lattice spacings l: large enough to
+#: clear the weight's energy barrier (the resting state is a strict local minimum), small
+#: enough that Newton from there stays in the basin of the nearby lifted shape.
+LIFT_PROBE_HEIGHT = 0.5
+
+
+def _lift_probe(
+    model: Model,
+    supports: Supports,
+    loads: Loads,
+    settings: Contact,
+    resting: StaticResult,
+    options: NewtonOptions,
+    floor: Floor,
+    lattice: Lattice,
+) -> tuple[StaticResult | None, float | None, int]:
+    """Look for a lifted equilibrium of lower total energy than ``resting``.
+
+    On a rigid floor under its weight a flat lattice is a strict local minimum at any
+    actuation: lifting any part by h costs weight × h, while the bending energy an
+    incompatible flat lattice releases by rising is of second order in h. So the resting
+    state does not lose stability (with the barrier floor it does, late, where the barrier's
+    finite stiffness gives way), and following it continuously (what Newton from the previous
+    step does) keeps a lattice flat that a real one — never perfectly flat, disturbed when
+    moved into the hot bath — leaves once a lifted shape is lower in energy. This probe runs where
+    the lattice still rests (every node within a filament diameter of its printed height) and
+    the unsupported lattice's lowest mode is unstable: it solves from the resting state lifted
+    along that mode's heights (both signs, shifted to be non-negative, highest point
+    :data:`LIFT_PROBE_HEIGHT` · l) and returns ``(best lifted result or None, its energy minus
+    the resting one or None, Newton iterations spent)``. A lifted result is returned only if
+    it is certified stable, lower in total energy (elastic + weight + barrier) and actually
+    off the floor.
+    """
+    diameter = 2.0 * lattice.radius
+    rest = floor.height_of(lattice.network.nodes)
+    if float((floor.height_of(resting.positions) - rest).max()) > diameter:
+        return None, None, 0
+    modes = stability(model, resting.state, supports, Loads(), count=1)
+    if modes.eigenvalues[0] >= 0:
+        return None, None, 0
+    v = modes.modes.displacements[0][:, 2]
+    if float(np.ptp(v)) == 0.0:
+        return None, None, 0
+    best: StaticResult | None = None
+    spent = 0
+    for sign in (1.0, -1.0):
+        dz = sign * v - float((sign * v).min())
+        dz *= LIFT_PROBE_HEIGHT * lattice.spacing / float(dz.max())
+        start = perturbed_state(model, dz, resting.state)
+        try:
+            trial = solve_static(
+                model, supports, loads, initial=start, options=options, contact=settings
+            )
+        except (ConvergenceError, InfeasibleContactError) as err:
+            spent += int(getattr(getattr(err, "result", None), "iterations", 0))
+            continue
+        spent += trial.iterations
+        lift = float((floor.height_of(trial.positions) - rest).max())
+        if lift > diameter and (best is None or trial.energy < best.energy):
+            best = trial
+    if best is None:
+        return None, None, spent
+    gap = best.energy - resting.energy
+    tol = 1e-9 * max(abs(resting.energy), abs(best.energy), 1e-300)
+    return (best if gap < -tol else None), gap, spent
 
 
 def _stable_flag(result: StaticResult) -> bool | None:

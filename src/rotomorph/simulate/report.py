@@ -256,9 +256,11 @@ def _heat(
     model: FilamentModel,
     ghosts: int,
     contact: bool = False,
+    branch: str = "lowest",
 ) -> tuple[Any, Any, str]:
     """(lattice, HeatingResult or None, reason): heated through the materials chain;
-    ``contact``: with self-contact, resting on the bath floor under its buoyant weight."""
+    ``contact``: with self-contact, resting on the bath floor under its buoyant weight;
+    ``branch``: which equilibrium a lattice resting on the floor follows (``heat_lattice``)."""
     try:
         from rotomorph.lattice import actuation as modes
         from rotomorph.lattice.heating import heat_lattice
@@ -273,12 +275,14 @@ def _heat(
     lattice = sinusoidal_lattice(n, 5.0, 1.25, ghosts, pattern)  # type: ignore[arg-type]
     try:
         actuation = mode(filament_model=model)
-        key = repr((pattern, n, ghosts, steps, actuation) + (("bath floor",) if contact else ()))
+        key = repr(
+            (pattern, n, ghosts, steps, actuation) + (("bath floor", branch) if contact else ())
+        )
         extra: dict[str, Any] = {}
         if contact:
             from rotomorph.lattice.heating import lattice_gravity
 
-            extra = {"floor": True, "gravity": lattice_gravity(lattice)}
+            extra = {"floor": True, "gravity": lattice_gravity(lattice), "branch": branch}
         result = disk_cached(
             "heat_lattice",
             key,
@@ -362,8 +366,14 @@ def _lattice_section(
                 f"{np.min(touched.min_clearance):.3f}) and the bath floor under buoyant "
                 f"weight; {int(touched.contacts_active[-1])} contacts at "
                 f"{touched.parameter[-1]:.0f} °C; largest rise off the floor "
-                f"{float(touched.floor_lift[-1]):.2f} mm; sd propagated through the same "
-                "lattice without contact"
+                f"{float(touched.floor_lift[-1]):.2f} mm"
+                + (
+                    ""
+                    if touched.first_lift_off() is None
+                    else f" (left the floor at {touched.first_lift_off():.4g} °C: the lifted "
+                    "equilibrium is lower in energy than the resting one)"
+                )
+                + "; sd propagated through the same lattice without contact"
                 if touched is not None
                 else ""
             )
@@ -395,6 +405,28 @@ def _lattice_section(
                 ),
             )
         )
+        lifted = None if touched is None else touched.first_lift_off()
+        if not quick and lifted is not None:
+            _, resting, why_r = _heat(pattern, quick, steps, model, coarse_g, True, "continuous")
+            rows.append(
+                _row(
+                    "lattice_area_ratio",
+                    f"{table.condition[i]}, kept on the floor",
+                    measured,
+                    spread,
+                    None if resting is None else float(resting.final_area_ratio),
+                    counted=False,
+                    unit="1",
+                    figure="fig3g_lattice_area.png",
+                    note=why_r
+                    or f"{size}; the same contact ramp following the resting state "
+                    "continuously (a metastable equilibrium on the floor: lifting costs "
+                    "weight × height to first order), where the counted row takes the "
+                    f"lifted equilibrium of lower energy from {lifted:.4g} °C on; largest "
+                    f"rise {float(resting.floor_lift[-1]):.2f} mm, "
+                    f"{int(resting.contacts_active[-1])} contacts",
+                )
+            )
         if not quick and res is not None:
             clearance = float(np.min(res.min_clearance))
             overlap = clearance < 1.0
