@@ -585,8 +585,9 @@ def _lift_probe(
     moved into the hot bath — leaves once a lifted shape is lower in energy. This probe runs where
     the lattice still rests (every node within a filament diameter of its printed height) and
     the unsupported lattice's lowest mode is unstable: it solves from the resting state lifted
-    along that mode's heights (both signs, shifted to be non-negative, highest point
-    :data:`LIFT_PROBE_HEIGHT` · l) and returns ``(best lifted result or None, its energy minus
+    along that mode (highest point :data:`LIFT_PROBE_HEIGHT` · l): first weightless and away
+    from the floor, where the lattice buckles freely; then laid on the floor either way up,
+    where it settles under its weight. It returns ``(best lifted result or None, its energy minus
     the resting one or None, Newton iterations spent)``. A lifted result is returned only if
     it is certified stable, lower in total energy (elastic + weight + barrier) and actually
     off the floor.
@@ -596,26 +597,52 @@ def _lift_probe(
     if float((floor.height_of(resting.positions) - rest).max()) > diameter:
         return None, None, 0
     modes = stability(model, resting.state, supports, Loads(), count=1)
+    phase_log.debug("lift probe: lowest unsupported eigenvalue %.3g", modes.eigenvalues[0])
     if modes.eigenvalues[0] >= 0:
         return None, None, 0
     v = modes.modes.displacements[0][:, 2]
     if float(np.ptp(v)) == 0.0:
         return None, None, 0
-    best: StaticResult | None = None
     spent = 0
-    for sign in (1.0, -1.0):
-        dz = sign * v - float((sign * v).min())
-        dz *= LIFT_PROBE_HEIGHT * lattice.spacing / float(dz.max())
-        start = perturbed_state(model, dz, resting.state)
+    # 1. the weightless lattice away from the floor buckles from the flat state along the mode
+    afloat = replace(settings, obstacles=tuple(o for o in settings.obstacles if o is not floor))
+    dz = v * (LIFT_PROBE_HEIGHT * lattice.spacing / float(np.abs(v).max()))
+    try:
+        free = solve_static(
+            model,
+            supports,
+            Loads(),
+            initial=perturbed_state(model, dz, resting.state),
+            options=options,
+            contact=afloat,
+        )
+    except (ConvergenceError, InfeasibleContactError) as err:
+        its = int(getattr(getattr(err, "result", None), "iterations", 0))
+        phase_log.debug("lift probe: the weightless lattice did not settle (%d its)", its)
+        return None, None, its
+    spent += free.iterations
+    # 2. laid on the floor either way up, it settles under its weight
+    best: StaticResult | None = None
+    gap_floor = float(floor.height_of(resting.positions).min())
+    for flip in (False, True):
+        start = _laid_on(free.state, floor, gap_floor, flip)
         try:
             trial = solve_static(
                 model, supports, loads, initial=start, options=options, contact=settings
             )
         except (ConvergenceError, InfeasibleContactError) as err:
             spent += int(getattr(getattr(err, "result", None), "iterations", 0))
+            phase_log.debug("lift probe (flip %s): did not settle", flip)
             continue
         spent += trial.iterations
         lift = float((floor.height_of(trial.positions) - rest).max())
+        phase_log.debug(
+            "lift probe (flip %s): rise %.3g mm, energy %.6g vs resting %.6g N mm",
+            flip,
+            lift,
+            trial.energy,
+            resting.energy,
+        )
         if lift > diameter and (best is None or trial.energy < best.energy):
             best = trial
     if best is None:
@@ -623,6 +650,22 @@ def _lift_probe(
     gap = best.energy - resting.energy
     tol = 1e-9 * max(abs(resting.energy), abs(best.energy), 1e-300)
     return (best if gap < -tol else None), gap, spent
+
+
+def _laid_on(state: State, floor: Floor, height: float, flip: bool) -> State:
+    """``state`` moved rigidly (turned upside down about the lattice's x axis when ``flip``)
+    so that its lowest node is ``height`` (mm) above ``floor``."""
+    n = np.asarray(floor.normal, dtype=float)
+    rot = np.eye(3)
+    if flip:  # a half turn about an axis in the floor's plane
+        a = unit(np.cross(n, [0.0, 1.0, 0.0] if abs(n[1]) < 0.9 else [1.0, 0.0, 0.0]))
+        rot = 2.0 * np.outer(a, a) - np.eye(3)
+    centre = state.positions.mean(axis=0)
+    pos = (state.positions - centre) @ rot.T + centre
+    pos += (height - float(floor.height_of(pos).min())) * n
+    return replace(
+        state, positions=pos, tangents=state.tangents @ rot.T, directors=state.directors @ rot.T
+    )
 
 
 def _stable_flag(result: StaticResult) -> bool | None:
