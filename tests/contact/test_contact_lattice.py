@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from rotomorph.design.lattices import sinusoidal_lattice
@@ -14,13 +15,19 @@ def test_contracting_lattice_on_the_floor_jams_instead_of_overlapping():
     lat = sinusoidal_lattice(n=3, pattern="contracting")
     # the 'swapped' reading keeps this small case fast (10-25 Newton iterations per step)
     free = heat_lattice(lat, steps=4, actuation="swapped")
-    res = heat_lattice(lat, steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
+    kw = dict(steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
+    res = heat_lattice(lat, branch="continuous", **kw)  # kept on the floor: it jams flat
     assert free.min_clearance.min() < 0.9  # without contact, filaments overlap
     assert res.min_clearance.min() >= 1.0  # allowed pairs, in units of r_a + r_b
     assert res.contacts_active[-1] > 0
     assert res.final_area_ratio > free.final_area_ratio + 0.1
     assert res.floor_lift is not None and res.floor_lift[-1] < 2 * lat.radius  # stays flat
     assert res.first_lift_off() is None
+    # the lowest-energy branch crumples off the floor instead, lower in energy, never overlapping
+    best = heat_lattice(lat, **kw)
+    assert best.min_clearance.min() >= 1.0
+    k = int(np.flatnonzero(best.floor_lift > 2 * lat.radius)[0])
+    assert best.lift_energy_gap[k] < 0.0 and best.energy[-1] < res.energy[-1]
 
 
 def test_gravity_on_a_free_lattice_needs_a_floor():
