@@ -13,8 +13,10 @@ boundary loop (paper Fig. 3G), the quadratic-surface fit of the branch nodes (Ga
 characteristic curvature √|k1 k2|, Fig. 4), the mean edge strain and every edge's end-to-end
 ratio (Fig. 4C/F "strain"), and the smallest distance between non-adjacent
 segments relative to the filament diameter, ignoring pairs already closer than a diameter as
-printed (fused at junctions). Contact is not modelled: values < 1 mean filaments overlap and
-``min_clearance`` ≈ 0 flags filaments passing through each other.
+printed (fused at junctions). Without ``contact`` filaments may pass through each other: values
+< 1 mean they overlap and ``min_clearance`` ≈ 0 flags filaments crossing. With ``contact`` or
+``floor`` they touch instead (:mod:`rotomorph.contact`), and a lattice resting on the floor
+under its weight takes a lifted equilibrium where one is lower in energy (``branch``).
 """
 
 from __future__ import annotations
@@ -558,10 +560,11 @@ def heat_lattice(
     )
 
 
-#: Height of the lifted starts of :func:`_lift_probe`, in lattice spacings l: large enough to
-#: clear the weight's energy barrier (the resting state is a strict local minimum), small
-#: enough that Newton from there stays in the basin of the nearby lifted shape.
-LIFT_PROBE_HEIGHT = 0.5
+#: Height of the lifted start of :func:`_lift_probe`, in lattice spacings l (0.5 mm for the
+#: paper's 5 mm cells, about a filament diameter): a start for the weightless buckling solve,
+#: whose flat state is unstable there, so any height leaves it (0.1 and 0.5 give the same end
+#: states of the paper's contracting, dome and saddle ramps, to the digits printed).
+LIFT_PROBE_HEIGHT = 0.1
 
 
 def _lift_probe(
