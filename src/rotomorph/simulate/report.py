@@ -531,7 +531,19 @@ def _lattice_section(
         )
         if res is not None:
             ax.plot(res.mean_edge_strain, res.characteristic_curvature, "ko-", ms=3,
-                    label="simulation")  # fmt: skip
+                    label="simulation (one point per ramp step)")  # fmt: skip
+            lift = res.first_lift_off()
+            if lift is not None:
+                k = int(np.flatnonzero(res.parameter == lift)[0])
+                ax.plot(
+                    res.mean_edge_strain[k],
+                    res.characteristic_curvature[k],
+                    "o",
+                    ms=9,
+                    mfc="none",
+                    mec="tab:red",
+                    label=f"leaves the floor ({lift:.4g} °C)",
+                )
         ax.set_xlabel("mean edge strain (–)")
         ax.set_ylabel("√|k1 k2| (1/mm)")
         ax.set_title(f"Fig. {panel}: {pattern} (κ_g {'>' if sign > 0 else '<'} 0)")
