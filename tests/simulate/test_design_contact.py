@@ -47,6 +47,7 @@ def test_self_contact_keeps_the_ring_apart():
         "floor": False,
         "gravity": False,
         "friction": 0.0,
+        "branch": "lowest",
     }
 
 
@@ -75,3 +76,17 @@ def test_on_the_floor_under_buoyant_weight():
 def test_bad_contact_tables_are_refused(contact, message):
     with pytest.raises(InvalidDesignError, match=message.replace(".", r"\.")):
         parse_design({**RING, "contact": contact})
+
+
+def test_the_floor_branch_reaches_the_lattice_ramp_and_a_bad_one_is_refused():
+    from rotomorph.design.lattices import sinusoidal_lattice
+    from rotomorph.simulate.surroundings import lattice_surroundings
+
+    lattice = sinusoidal_lattice(n=2, ghost_nodes=2)
+    for branch in ("lowest", "continuous"):
+        design = parse_design(
+            {**RING, "contact": {"floor": True, "gravity": True, "branch": branch}}
+        )
+        assert lattice_surroundings(design.contact, lattice, 175.0)["branch"] == branch
+    with pytest.raises(InvalidDesignError, match="branch"):
+        parse_design({**RING, "contact": {"floor": True, "branch": "global"}})

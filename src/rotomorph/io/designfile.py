@@ -530,6 +530,11 @@ class ContactModel(_Model):
     friction: float = Field(
         0.0, ge=0, le=10, description="Coulomb friction coefficient of every contact"
     )
+    branch: Literal["lowest", "continuous"] = Field(
+        "lowest",
+        description="lattices resting on the floor under their weight: 'lowest' takes a lifted "
+        "equilibrium where one is lower in energy, 'continuous' follows the resting state",
+    )
 
     @model_validator(mode="after")
     def _weight_needs_support(self) -> ContactModel:

@@ -72,7 +72,7 @@ def filament_surroundings(
 
 def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict[str, Any]:
     """Keyword arguments of :func:`rotomorph.lattice.heating.heat_lattice` for ``[contact]``
-    (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``."""
+    (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``, ``branch``."""
     if contact is None:
         return {}
     from rotomorph.lattice.heating import lattice_gravity  # lattice-only
@@ -81,6 +81,7 @@ def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict
         "contact": Contact(radius=lattice.radius, self_contact=contact.self_contact),
         "floor": bool(contact.floor),
         "friction": float(contact.friction),
+        "branch": str(contact.branch),
     }
     if contact.gravity:
         kwargs["gravity"] = lattice_gravity(
@@ -98,6 +99,7 @@ def surroundings_record(contact: Any, temperature: float) -> dict[str, Any] | No
         "floor": bool(contact.floor),
         "gravity": bool(contact.gravity),
         "friction": float(contact.friction),
+        "branch": str(contact.branch),
     }
     if contact.gravity:
         fluid = bath_fluids()[contact.bath]
