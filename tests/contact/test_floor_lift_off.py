@@ -57,3 +57,13 @@ def test_the_default_takes_the_lifted_dome_where_it_is_lower_in_energy(ramps, do
 def test_a_bad_branch_name_is_refused(dome):
     with pytest.raises(InvalidParameterError, match="branch"):
         heat_lattice(dome, actuation=ACT, steps=1, branch="global")  # type: ignore[arg-type]
+
+
+def test_a_perfectly_flat_dome_on_the_floor_still_rises(dome):
+    """No symmetry-breaking noise: the flat dome on the floor is a minimum of the floor problem
+    at every step, and only the lift probe finds the dome."""
+    flat = heat_lattice(
+        dome, actuation=ACT, steps=8, floor=True, gravity=lattice_gravity(dome), perturbation=0.0
+    )
+    assert flat.gaussian_sign[-1] == 1 and all(flat.stable)
+    assert flat.first_lift_off() is not None

@@ -406,6 +406,7 @@ def _lattice_section(
             )
         )
         lifted = None if touched is None else touched.first_lift_off()
+        resting = None
         if not quick and lifted is not None:
             _, resting, why_r = _heat(pattern, quick, steps, model, coarse_g, True, "continuous")
             rows.append(
@@ -455,6 +456,9 @@ def _lattice_section(
         if touched is not None:
             ax.plot(touched.parameter, touched.area_ratio, "s-", ms=3,
                     label=f"{pattern} (contact, on the floor)")  # fmt: skip
+        if resting is not None:
+            ax.plot(resting.parameter, resting.area_ratio, "s--", ms=3, mfc="none",
+                    label=f"{pattern} (contact, kept on the floor)")  # fmt: skip
         x_end = 0.75 if res is None else float(res.parameter[-1])
         ax.errorbar([x_end], [measured], yerr=[spread], fmt="s", capsize=3,
                     label=f"{pattern} (measured, 175 °C)")  # fmt: skip
