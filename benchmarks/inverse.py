@@ -144,7 +144,7 @@ def main() -> None:
     )
     its = 6 if args.quick else 20
     # |K| = 4.9e-3 1/mm² for both: inside what the 5 x 5 patterns give at printable speeds
-    # (the dome pattern alone: K = 3.3e-3 at 0.25 mm/s, 1.3e-2 at 3 mm/s)
+    # (the dome pattern alone: K = 6.5e-4 at 0.25 mm/s, 1.1e-2 at 0.5, 2.3e-2 at 3 mm/s)
     lattice_case("lattice-dome", "dome", dome(0.07), its)
     lattice_case("lattice-saddle", "saddle", saddle(0.07), its)
 

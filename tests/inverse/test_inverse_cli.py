@@ -56,6 +56,11 @@ def test_curve_target_to_a_design_the_other_commands_accept(tmp_path, capsys):
             "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\nfriction = 0.2\n",
             "frictionless",
         ),
+        (
+            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
+            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\ngravity = true\n",
+            "contact.branch",
+        ),
     ],
 )
 def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):
@@ -64,6 +69,24 @@ def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):
     assert main(["inverse", str(target), "-o", str(tmp_path / "d.toml")]) == 2
     err = capsys.readouterr().err.strip()
     assert fragment in err and len(err.splitlines()) == 1
+
+
+def test_lattice_target_resting_on_the_floor_gives_a_design_simulate_runs_alike(tmp_path):
+    """A lattice target with floor and weight runs end to end; the design file and the summary
+    carry the branch it was designed on, so simulate solves the same equilibria."""
+    target = tmp_path / "rest.toml"
+    target.write_text(
+        'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.1\n[lattice]\nn = 3\n'
+        "spacing = 5.0\namplitude = 1.25\nghost_nodes = 6\n[options]\nmax_iterations = 2\n"
+        '[contact]\nfloor = true\ngravity = true\nbranch = "continuous"\n',
+        encoding="utf-8",
+    )
+    out = tmp_path / "rest_design.toml"
+    assert main(["inverse", str(target), "-o", str(out)]) == 0
+    summary = json.loads((tmp_path / "rest_design_inverse" / "summary.json").read_text())
+    assert summary["contact"]["branch"] == "continuous" and summary["contact"]["gravity"]
+    assert 'branch = "continuous"' in out.read_text(encoding="utf-8")
+    assert main(["validate", str(out)]) == 0
 
 
 def test_non_utf8_target_is_refused(tmp_path, capsys):

@@ -204,6 +204,7 @@ def run_inverse(
     surf = target.surface_target()
     env = lattice_surroundings(target.contact, lat, opt.temperature)
     env.pop("friction", None)  # 0: the target file refuses friction
+    env.pop("branch", None)  # 'continuous' wherever it matters: the target file refuses the probe
     des = design_lattice(
         lat,
         surf,

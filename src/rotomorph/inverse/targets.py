@@ -25,8 +25,9 @@ Lattice targets (``dome``, ``saddle``, ``height_map``) give the curvatures (1/mm
 grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``amplitude``,
 ``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
 An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``, ``gravity``,
-``bath``; frictionless only) makes every equilibrium of a lattice design, and its adjoint, touch
-and rest as ``rotomorph simulate`` will; it is copied into the resulting design file.
+``bath``, ``branch``; frictionless only; with ``floor`` and ``gravity`` the branch must be
+``"continuous"``) makes every equilibrium of a lattice design, and its adjoint, touch and rest as
+``rotomorph simulate`` will; it is copied into the resulting design file.
 """
 
 from __future__ import annotations
@@ -148,6 +149,17 @@ class TargetFile(_Model):
             raise ValueError(
                 "contact.friction must be 0: inverse design needs frictionless contact "
                 "(lagged friction has no adjoint gradient)"
+            )
+        if (
+            self.contact is not None
+            and self.contact.floor
+            and self.contact.gravity
+            and self.contact.branch != "continuous"
+        ):
+            raise ValueError(
+                "contact.branch must be 'continuous' with floor and gravity: inverse design "
+                "follows the resting state continuously (no lowest-energy lift probe); set "
+                'branch = "continuous" in [contact]'
             )
         if self.options.min_speed >= self.options.max_speed:
             raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
