@@ -67,3 +67,14 @@ def test_a_perfectly_flat_dome_on_the_floor_still_rises(dome):
     )
     assert flat.gaussian_sign[-1] == 1 and all(flat.stable)
     assert flat.first_lift_off() is not None
+
+
+@pytest.mark.parametrize(
+    "kw", [{"supports": "pinned-centre"}, {"friction": 0.3}], ids=["supported", "friction"]
+)
+def test_no_probe_where_it_would_move_supports_or_compare_dissipation(kw):
+    """The probe moves the lattice rigidly and compares total energies: not with supports
+    (they would move) nor with lagged friction (not a potential); those ramps are continuous."""
+    lat = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="dome")
+    res = heat_lattice(lat, actuation=ACT, steps=1, floor=True, gravity=lattice_gravity(lat), **kw)
+    assert res.lift_energy_gap is None

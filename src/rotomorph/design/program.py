@@ -208,8 +208,8 @@ class PrintProgram:
         deposited filament is twisted only by the part of that turn the filament's own frame
         does not share. The interface is a material surface, so every material line of the
         section winds around the filament at the interface's rate dα/ds, and the shear-aligned
-        director follows the material lines (the paper's ω = v dα/ds, φ = atan ω*). On a
-        straight path this is :attr:`rotation`; a nozzle that only tracks the heading of a
+        director follows the material lines (φ = atan ω*). On a straight path this is
+        :attr:`rotation`, the paper's ω; a nozzle that only tracks the heading of a
         curved path (the active half kept on one side) winds no helix. With ``step_flips``
         the ideal flips (interface-angle changes of π/2 or more over one edge) have zero
         length and wind none either.

@@ -402,7 +402,17 @@ class _Derived:
         self._program = program
         self._memo: dict[str, Any] = {}
 
+    def __getstate__(self) -> Any:
+        return self._program
+
+    def __setstate__(self, program: Any) -> None:
+        self._program = program
+        self._memo = {}
+
     def __getattr__(self, name: str) -> Any:
+        if name in ("_memo", "_program") or name.startswith("__"):
+            # unset slots (an instance being unpickled or copied) and protocol lookups
+            raise AttributeError(name)
         memo = self._memo
         if name not in memo:
             memo[name] = getattr(self._program, name)

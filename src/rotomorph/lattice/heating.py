@@ -188,7 +188,9 @@ class HeatingResult:
     positions
         Node positions ``(steps+1, N, 3)`` (mm).
     energy
-        Elastic energy at equilibrium (N mm; 0 when printed).
+        Total potential energy of each equilibrium (N mm; :attr:`StaticResult.energy`: elastic,
+        minus the work of gravity on the absolute heights, plus contact terms); 0 in row 0,
+        which is not the printed state's total.
     iterations
         Newton iterations spent reaching each step (halved sub-steps included).
     halvings
@@ -415,14 +417,17 @@ def heat_lattice(
     branch
         Which equilibrium a lattice resting on a floor under its weight follows.
         ``"continuous"``: the one reached continuously from the previous step. On a rigid
-        floor under any weight a perfectly flat lattice never loses stability (lifting costs
-        weight × height to first order, the bending energy it releases is of second order), so
+        floor under any weight a perfectly flat lattice whose weightless flat state is an
+        equilibrium never loses stability (lifting costs weight × height to first order, the
+        bending energy it releases is of second order), so
         the resting state is left only where the barrier's finite stiffness gives way, late and
         with a snap. ``"lowest"`` (default): at every step where the lattice still rests on the
         floor and the unsupported lattice's lowest mode is unstable, also solve from lifted
         starts along that mode and keep the equilibrium of lower total energy — the state an
-        imperfect real lattice, disturbed as it is moved into the hot bath, settles in
-        (:func:`_lift_probe`; ``lift_energy_gap`` records the comparison).
+        imperfect real lattice, disturbed as it is moved into the hot bath, can settle in
+        (:func:`_lift_probe`; ``lift_energy_gap`` records the comparison). The probe runs only
+        for free lattices without friction (it moves the lattice rigidly, and lagged friction
+        is not a potential to compare); otherwise the ramp is continuous.
 
     Returns
     -------
@@ -466,9 +471,15 @@ def heat_lattice(
         )
     if branch not in ("lowest", "continuous"):
         raise InvalidParameterError("branch", f"must be 'lowest' or 'continuous'; got {branch!r}")
+    # the probe moves the lattice rigidly (supports would move with it) and compares total
+    # energies (lagged friction is dissipation, not a potential): free, frictionless only
     probe_floor = (
         settings.floor
-        if branch == "lowest" and settings is not None and gravity is not None
+        if branch == "lowest"
+        and settings is not None
+        and gravity is not None
+        and sup.is_free
+        and not settings.friction
         else None
     )
     values = np.linspace(act.start, act.end, int(steps) + 1)
@@ -579,21 +590,26 @@ def _lift_probe(
 ) -> tuple[StaticResult | None, float | None, int]:
     """Look for a lifted equilibrium of lower total energy than ``resting``.
 
-    On a rigid floor under its weight a flat lattice is a strict local minimum at any
-    actuation: lifting any part by h costs weight × h, while the bending energy an
-    incompatible flat lattice releases by rising is of second order in h. So the resting
-    state does not lose stability (with the barrier floor it does, late, where the barrier's
-    finite stiffness gives way), and following it continuously (what Newton from the previous
-    step does) keeps a lattice flat that a real one — never perfectly flat, disturbed when
-    moved into the hot bath — leaves once a lifted shape is lower in energy. This probe runs where
-    the lattice still rests (every node within a filament diameter of its printed height) and
-    the unsupported lattice's lowest mode is unstable: it solves from the resting state lifted
-    along that mode (highest point :data:`LIFT_PROBE_HEIGHT` · l): first weightless and away
-    from the floor, where the lattice buckles freely; then laid on the floor either way up,
-    where it settles under its weight. It returns ``(best lifted result or None, its energy minus
-    the resting one or None, Newton iterations spent)``. A lifted result is returned only if
-    it is certified stable, lower in total energy (elastic + weight + barrier) and actually
-    off the floor.
+    On a rigid floor under a positive weight, a flat lattice whose weightless flat state is an
+    equilibrium (natural curvatures in the plane, no eigen-twist: e.g. lines whose nozzle only
+    tracks the heading) and stable against in-plane and twist motions is a strict local
+    minimum at any actuation: lifting any part by h costs weight × h, while the bending energy
+    an incompatible flat lattice releases by rising is of second order in h. (A natural field
+    that pushes the flat state out of the plane, such as an eigen-twist, lifts it by itself.)
+    So the resting state does not lose stability (with the barrier floor it does, late, where
+    the barrier's finite stiffness gives way), and following it continuously (what Newton
+    from the previous step does) keeps a lattice flat that a real one — never perfectly flat,
+    disturbed when moved into the hot bath — can leave once a lifted shape is lower in energy
+    (the lowest-energy choice). This probe runs where the lattice still rests (every node
+    within a filament diameter of its printed height) and the unsupported lattice's lowest
+    mode is unstable: it solves from the resting state lifted along that mode (highest point
+    :data:`LIFT_PROBE_HEIGHT` · l): first weightless and away from the floor, where the
+    lattice buckles freely; then laid on the floor either way up (one buckled shape, two
+    orientations), where it settles under its weight. It returns ``(best lifted result or
+    None, its energy minus the resting one or None, Newton iterations spent)``. A lifted
+    result is returned only if it is certified stable, lower in total energy (elastic +
+    weight + barrier) and actually off the floor. A lift found inside a halved sub-step is
+    taken but its gap is recorded under that sub-step's parameter, not in the ramp's rows.
     """
     diameter = 2.0 * lattice.radius
     rest = floor.height_of(lattice.network.nodes)
@@ -646,7 +662,7 @@ def _lift_probe(
             trial.energy,
             resting.energy,
         )
-        if lift > diameter and (best is None or trial.energy < best.energy):
+        if lift > diameter and trial.stable and (best is None or trial.energy < best.energy):
             best = trial
     if best is None:
         return None, None, spent

@@ -32,8 +32,10 @@ class StaticResult:
     iterations, factorizations
         Newton iterations and linear factorizations used.
     energy
-        Total potential energy at equilibrium (N mm; elastic minus the work of dead loads
-        relative to the last Newton base).
+        Total potential energy at equilibrium (N mm): elastic energy, minus the work of dead
+        forces and gravity on the absolute node positions (so equilibria of one model under the
+        same loads compare directly), plus the contact barrier and lagged friction terms when
+        contact is on.
     residual
         Weighted gradient norm relative to the problem's force scale.
     wall_time
