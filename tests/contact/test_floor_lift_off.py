@@ -78,3 +78,29 @@ def test_no_probe_where_it_would_move_supports_or_compare_dissipation(kw):
     lat = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="dome")
     res = heat_lattice(lat, actuation=ACT, steps=1, floor=True, gravity=lattice_gravity(lat), **kw)
     assert res.lift_energy_gap is None
+
+
+def test_lift_off_and_weightless_buckling_are_bisected_and_ordered(dome, ramps):
+    """The weight delays lift-off: the flat lattice must first buckle without it (the probe
+    searches only along an unstable mode), then gain enough to pay for lifting its weight."""
+    tol = 0.02
+    res = heat_lattice(
+        dome,
+        actuation=ACT,
+        steps=8,
+        floor=True,
+        gravity=lattice_gravity(dome),
+        lift_off_tolerance=tol,
+    )
+    # the same ramp as without refinement
+    np.testing.assert_array_equal(res.positions, ramps["lowest"].positions)
+    (lo, hi), (b_lo, b_hi) = res.lift_off_bracket, res.buckling_bracket
+    assert 0 < hi - lo <= tol and 0 < b_hi - b_lo <= tol
+    k = int(np.flatnonzero(res.floor_lift > 2.0 * dome.radius)[0])
+    assert res.parameter[k - 1] <= lo < hi <= res.parameter[k]
+    # it buckles (weightless) first, and leaves the floor only a finite step later: just past
+    # buckling the energy released (second order in the rise) cannot pay for the weight
+    # (first order)
+    assert b_hi <= lo
+    with pytest.raises(InvalidParameterError, match="lift_off_tolerance"):
+        heat_lattice(dome, actuation=ACT, steps=1, lift_off_tolerance=0.0)

@@ -22,6 +22,7 @@ under its weight takes a lifted equilibrium where one is lower in energy (``bran
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -234,6 +235,12 @@ class HeatingResult:
         equilibrium found minus that of the resting one at each step where the lattice rested
         on the floor and its unsupported lowest mode was unstable (N mm; negative: the lifted
         branch was taken); NaN where no lifted equilibrium was probed or found.
+    lift_off_bracket, buckling_bracket
+        With ``lift_off_tolerance``: ramp-parameter intervals ``(lo, hi)`` holding the
+        lift-off (at ``lo`` the lattice rests and no lower lifted state was found, at ``hi``
+        one was) and the buckling of the weightless flat lattice (its lowest mode stable at
+        ``lo``, unstable at ``hi``); None where not refined or not reached. Their difference
+        is the delay the weight causes.
     """
 
     parameter: FloatArray
@@ -259,6 +266,8 @@ class HeatingResult:
     contacts_active: IntArray | None = None
     floor_lift: FloatArray | None = None
     lift_energy_gap: FloatArray | None = None
+    lift_off_bracket: tuple[float, float] | None = None
+    buckling_bracket: tuple[float, float] | None = None
 
     @property
     def final_area_ratio(self) -> float:
@@ -371,6 +380,7 @@ def heat_lattice(
     floor: bool | Floor = False,
     friction: float = 0.0,
     branch: Literal["lowest", "continuous"] = "lowest",
+    lift_off_tolerance: float | None = None,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -428,6 +438,13 @@ def heat_lattice(
         (:func:`_lift_probe`; ``lift_energy_gap`` records the comparison). The probe runs only
         for free lattices without friction (it moves the lattice rigidly, and lagged friction
         is not a potential to compare); otherwise the ramp is continuous.
+    lift_off_tolerance
+        With ``branch="lowest"``: where the lattice leaves the floor, bisect the ramp
+        parameter to this width for the lift-off (the first lifted equilibrium lower in
+        energy) and for the buckling of the weightless flat lattice (its lowest mode turning
+        unstable), so the weight's delay of lift-off is resolved below the step size
+        (``HeatingResult.lift_off_bracket``, ``buckling_bracket``; the extra solves are not
+        in ``iterations``). Default None: not refined.
 
     Returns
     -------
@@ -468,6 +485,12 @@ def heat_lattice(
             "supports",
             "gravity on a free lattice needs a floor to rest on (floor=True) or a support "
             "('pinned-centre' or 'clamped-boundary')",
+        )
+    if lift_off_tolerance is not None and not (
+        np.isfinite(lift_off_tolerance) and lift_off_tolerance > 0
+    ):
+        raise InvalidParameterError(
+            "lift_off_tolerance", f"must be > 0 (ramp units) or None; got {lift_off_tolerance}"
         )
     if branch not in ("lowest", "continuous"):
         raise InvalidParameterError("branch", f"must be 'lowest' or 'continuous'; got {branch!r}")
@@ -515,6 +538,22 @@ def heat_lattice(
         return res
 
     path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
+    brackets: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)
+    if probe_floor is not None and lift_off_tolerance is not None:
+        assert settings is not None  # a floor implies contact settings
+        phase_log.info("lift-off: bisecting the ramp parameter")
+        brackets = _refine_lift_off(
+            lambda p: act.natural(lm, p),
+            sup,
+            loads,
+            settings,
+            options,
+            probe_floor,
+            lattice,
+            values,
+            [initial] + [r.state for r in path.results],
+            float(lift_off_tolerance),
+        )
     phase_log.info("analysis: areas, surface fits, edge ratios, clearances")
     ref = lattice.network.nodes
     loop = lattice_boundary_loop(lattice.edge_chains, lattice.n)
@@ -568,6 +607,8 @@ def heat_lattice(
         lift_energy_gap=None
         if probe_floor is None
         else np.array([np.nan] + [probes.get(float(v), np.nan) for v in values[1:]]),
+        lift_off_bracket=brackets[0],
+        buckling_bracket=brackets[1],
     )
 
 
@@ -669,6 +710,80 @@ def _lift_probe(
     gap = best.energy - resting.energy
     tol = 1e-9 * max(abs(resting.energy), abs(best.energy), 1e-300)
     return (best if gap < -tol else None), gap, spent
+
+
+def _refine_lift_off(
+    natural: Callable[[float], Model],
+    supports: Supports,
+    loads: Loads,
+    settings: Contact,
+    options: NewtonOptions,
+    floor: Floor,
+    lattice: Lattice,
+    values: FloatArray,
+    states: list[State],
+    tol: float,
+) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
+    """Bisect the lift-off and the weightless buckling of a ramp (see ``lift_off_tolerance``).
+
+    ``states[k]`` is the ramp's equilibrium at ``values[k]`` (``states[0]`` the printed
+    start). Both brackets start from the last resting step before the first lifted one; the
+    buckling bracket steps back further while the weightless lattice is already unstable
+    there. Every trial solves the resting equilibrium from the bracket's lower state. A
+    failed solve stops that bisection at the bracket reached.
+    """
+    diameter = 2.0 * lattice.radius
+    rest = floor.height_of(lattice.network.nodes)
+
+    def lifted(state: State) -> bool:
+        return float((floor.height_of(state.positions) - rest).max()) > diameter
+
+    first = next((k for k in range(1, len(states)) if lifted(states[k])), None)
+    if first is None:
+        return None, None
+
+    def resting(p: float, start: State) -> tuple[Model, StaticResult]:
+        model = natural(p)
+        return model, solve_static(
+            model, supports, loads, initial=start, options=options, contact=settings
+        )
+
+    def leaves(p: float, start: State) -> tuple[bool, State]:
+        model, res = resting(p, start)
+        if lifted(res.state):
+            return True, res.state
+        best, _, _ = _lift_probe(model, supports, loads, settings, res, options, floor, lattice)
+        return best is not None, res.state
+
+    def buckled(p: float, start: State) -> tuple[bool, State]:
+        model, res = resting(p, start)
+        eig = stability(model, res.state, supports, Loads(), count=1).eigenvalues[0]
+        return bool(eig < 0), res.state
+
+    def bisect(test, lo: float, lo_state: State, hi: float) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+        while hi - lo > tol:
+            mid = 0.5 * (lo + hi)
+            try:
+                flag, state = test(mid, lo_state)
+            except (ConvergenceError, InfeasibleContactError):
+                break
+            if flag:
+                hi = mid
+            else:
+                lo, lo_state = mid, state
+        return lo, hi
+
+    k = first - 1
+    lift = bisect(leaves, float(values[k]), states[k], float(values[first]))
+    # the weightless lattice is unstable where the lift-off was found; step back to a stable one
+    j = k
+    while j > 0:
+        eig = stability(natural(float(values[j])), states[j], supports, Loads(), count=1)
+        if eig.eigenvalues[0] >= 0:
+            break
+        j -= 1
+    buckle = bisect(buckled, float(values[j]), states[j], float(values[j + 1]))
+    return lift, buckle
 
 
 def _laid_on(state: State, floor: Floor, height: float, flip: bool) -> State:

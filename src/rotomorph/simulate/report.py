@@ -244,6 +244,8 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 LATTICE_GHOSTS = {True: (6, 12), False: (10, 20)}
 #: Heating steps of the full lattice ramps.
 LATTICE_STEPS = 8
+#: Width (°C) to which the dome's and saddle's lift-off and weightless buckling are bisected.
+LIFT_OFF_TOLERANCE = 0.5
 #: Heating steps of the perturbed ramps that propagate the calibration's uncertainty (the
 #: final state of an elastic ramp does not depend on the steps once each converges).
 SD_STEPS = 4
@@ -257,6 +259,7 @@ def _heat(
     ghosts: int,
     contact: bool = False,
     branch: str = "lowest",
+    lift_off_tolerance: float | None = None,
 ) -> tuple[Any, Any, str]:
     """(lattice, HeatingResult or None, reason): heated through the materials chain;
     ``contact``: with self-contact, resting on the bath floor under its buoyant weight;
@@ -276,13 +279,19 @@ def _heat(
     try:
         actuation = mode(filament_model=model)
         key = repr(
-            (pattern, n, ghosts, steps, actuation) + (("bath floor", branch) if contact else ())
+            (pattern, n, ghosts, steps, actuation)
+            + (("bath floor", branch, lift_off_tolerance) if contact else ())
         )
         extra: dict[str, Any] = {}
         if contact:
             from rotomorph.lattice.heating import lattice_gravity
 
-            extra = {"floor": True, "gravity": lattice_gravity(lattice), "branch": branch}
+            extra = {
+                "floor": True,
+                "gravity": lattice_gravity(lattice),
+                "branch": branch,
+                "lift_off_tolerance": lift_off_tolerance,
+            }
         result = disk_cached(
             "heat_lattice",
             key,
@@ -338,7 +347,15 @@ def _lattice_section(
         {}
         if quick
         else {
-            p: _heat(p, quick, steps, model, coarse_g, contact=True)
+            p: _heat(
+                p,
+                quick,
+                steps,
+                model,
+                coarse_g,
+                contact=True,
+                lift_off_tolerance=LIFT_OFF_TOLERANCE if p in ("dome", "saddle") else None,
+            )
             for p in ("expanding", "contracting", "dome", "saddle")
         }
     )
@@ -533,6 +550,27 @@ def _lattice_section(
                 f"{res.mean_edge_strain[-1]:+.3f}; the paper gives this only as a plot",
             )
         )
+        if res is not None and getattr(res, "lift_off_bracket", None) is not None:
+            lo, hi = res.lift_off_bracket
+            b_lo, b_hi = res.buckling_bracket or (np.nan, np.nan)
+            rows.append(
+                _row(
+                    "lattice_lift_off_temperature",
+                    f"{pattern} lattice on the bath floor",
+                    None,
+                    None,
+                    round(0.5 * (lo + hi), 2),
+                    disc_error=0.5 * (hi - lo),
+                    unit="°C",
+                    figure="fig4cf_characteristic_curvature.png",
+                    note=f"{size}; the first temperature at which a lifted equilibrium is lower "
+                    f"in total energy than the lattice resting flat under its buoyant weight, "
+                    f"bisected to [{lo:.2f}, {hi:.2f}] °C; the weightless flat lattice buckles "
+                    f"at [{b_lo:.2f}, {b_hi:.2f}] °C, so the weight delays lift-off by "
+                    f"{0.5 * (lo + hi - b_lo - b_hi):.1f} °C (the paper: a finite delay, "
+                    "larger for the saddle; no number given)",
+                )
+            )
         if res is not None:
             ax.plot(res.mean_edge_strain, res.characteristic_curvature, "ko-", ms=3,
                     label="simulation (one point per ramp step)")  # fmt: skip
@@ -675,7 +713,11 @@ def _markdown(
         ("Fig. 3G — lattice area", ("lattice_area_ratio",)),
         (
             "Fig. 4 — dome and saddle lattices",
-            ("lattice_gaussian_sign", "lattice_characteristic_curvature"),
+            (
+                "lattice_gaussian_sign",
+                "lattice_characteristic_curvature",
+                "lattice_lift_off_temperature",
+            ),
         ),
         ("Inputs (measured values the model takes as given)", ("order_parameter",
                                                                 "normalized_length")),
