@@ -362,6 +362,24 @@ def _lattice_section(
     if not quick:
         for pattern in ("expanding", "contracting"):
             fine[pattern] = _heat(pattern, quick, steps, model, fine_g, contact=True)[1]
+    # dome and saddle at the finer resolution too: their counted sign, curvature and lift-off
+    # come from it, the coarser one is the convergence check
+    surfaces = (
+        {}
+        if quick
+        else {
+            p: _heat(
+                p,
+                quick,
+                steps,
+                model,
+                fine_g,
+                contact=True,
+                lift_off_tolerance=LIFT_OFF_TOLERANCE,
+            )
+            for p in ("dome", "saddle")
+        }
+    )
     # Fig. 3G: area
     fig = new_figure(6.0, 4.2)
     ax = fig.add_subplot()
@@ -489,7 +507,7 @@ def _lattice_section(
     # Fig. 3E/F and Fig. 4A/D: views coloured by (κ − κ_i)/κ_i at the end of the ramp,
     # contact-resolved where filaments touch
     for pattern in ("expanding", "contracting", "dome", "saddle"):
-        lattice, res, _ = resolved.get(pattern, results[pattern])
+        lattice, res, _ = surfaces.get(pattern, resolved.get(pattern, results[pattern]))
         if res is None or figs is None:
             continue
         k = len(res.parameter) - 1
@@ -511,7 +529,14 @@ def _lattice_section(
     for ax, (pattern, sign, panel) in zip(
         axes, (("dome", 1, "4C"), ("saddle", -1, "4F")), strict=True
     ):
-        lattice, res, why = resolved.get(pattern, results[pattern])
+        coarse = resolved.get(pattern, results[pattern])[1]
+        lattice, res, why = surfaces.get(pattern, resolved.get(pattern, results[pattern]))
+        other = None if coarse is None or coarse is res else coarse
+        check: dict[str, Any] = (
+            {}
+            if other is None
+            else {"resolution": (coarse_g, fine_g), "resolution_unit": "ghost nodes per edge"}
+        )
         rows.append(
             _row(
                 "lattice_gaussian_sign",
@@ -520,6 +545,8 @@ def _lattice_section(
                 0.0,
                 None if res is None else float(res.gaussian_sign[-1]),
                 counted=res is not None,
+                other=None if other is None else float(other.gaussian_sign[-1]),
+                **check,
                 calibrated_without="lattice (never fitted)",
                 unit="1",
                 figure="fig4cf_characteristic_curvature.png",
@@ -543,6 +570,8 @@ def _lattice_section(
                 None,
                 None,
                 None if res is None else float(res.characteristic_curvature[-1]),
+                other=None if other is None else float(other.characteristic_curvature[-1]),
+                **check,
                 unit="1/mm",
                 figure="fig4cf_characteristic_curvature.png",
                 note=why
@@ -553,6 +582,8 @@ def _lattice_section(
         if res is not None and getattr(res, "lift_off_bracket", None) is not None:
             lo, hi = res.lift_off_bracket
             b_lo, b_hi = res.buckling_bracket or (np.nan, np.nan)
+            o_br = None if other is None else other.lift_off_bracket
+            o_mid = None if o_br is None else 0.5 * (o_br[0] + o_br[1])
             rows.append(
                 _row(
                     "lattice_lift_off_temperature",
@@ -560,7 +591,11 @@ def _lattice_section(
                     None,
                     None,
                     round(0.5 * (lo + hi), 2),
-                    disc_error=0.5 * (hi - lo),
+                    other=o_mid,
+                    disc_error=max(
+                        0.5 * (hi - lo), 0.0 if o_mid is None else abs(o_mid - 0.5 * (lo + hi))
+                    ),
+                    **check,
                     unit="°C",
                     figure="fig4cf_characteristic_curvature.png",
                     note=f"{size}; the first temperature at which a lifted equilibrium is lower "
