@@ -623,7 +623,11 @@ def _lattice_section(
                 )
         ax.set_xlabel("mean edge strain (–)")
         ax.set_ylabel("√|k1 k2| (1/mm)")
-        ax.set_title(f"Fig. {panel}: {pattern} (κ_g {'>' if sign > 0 else '<'} 0)")
+        got = "" if res is None else f", simulated sign {int(res.gaussian_sign[-1]):+d}"
+        ax.set_title(
+            f"Fig. {panel}: {pattern} pattern (paper: κ_g {'>' if sign > 0 else '<'} 0{got})",
+            fontsize=10,
+        )
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     if figs is not None:
