@@ -579,8 +579,7 @@ def heat_lattice(
         clearance = np.array([pot.clearance(p) for p in positions])
         active = np.array([pot.active_contacts(p) for p in positions], dtype=np.int64)
         if settings.floor is not None:
-            rest = settings.floor.height_of(positions[0])
-            lift = np.array([float((settings.floor.height_of(p) - rest).max()) for p in positions])
+            lift = np.array([_rise(settings.floor, lattice, p) for p in positions])
     return HeatingResult(
         parameter=values,
         positions=positions,
@@ -653,8 +652,7 @@ def _lift_probe(
     taken but its gap is recorded under that sub-step's parameter, not in the ramp's rows.
     """
     diameter = 2.0 * lattice.radius
-    rest = floor.height_of(lattice.network.nodes)
-    if float((floor.height_of(resting.positions) - rest).max()) > diameter:
+    if _rise(floor, lattice, resting.positions) > diameter:
         return None, None, 0
     modes = stability(model, resting.state, supports, Loads(), count=1)
     phase_log.debug("lift probe: lowest unsupported eigenvalue %.3g", modes.eigenvalues[0])
@@ -695,7 +693,7 @@ def _lift_probe(
             phase_log.debug("lift probe (flip %s): did not settle", flip)
             continue
         spent += trial.iterations
-        lift = float((floor.height_of(trial.positions) - rest).max())
+        lift = _rise(floor, lattice, trial.positions)
         phase_log.debug(
             "lift probe (flip %s): rise %.3g mm, energy %.6g vs resting %.6g N mm",
             flip,
@@ -733,10 +731,9 @@ def _refine_lift_off(
     failed solve stops that bisection at the bracket reached.
     """
     diameter = 2.0 * lattice.radius
-    rest = floor.height_of(lattice.network.nodes)
 
     def lifted(state: State) -> bool:
-        return float((floor.height_of(state.positions) - rest).max()) > diameter
+        return _rise(floor, lattice, state.positions) > diameter
 
     first = next((k for k in range(1, len(states)) if lifted(states[k])), None)
     if first is None:
@@ -784,6 +781,11 @@ def _refine_lift_off(
         j -= 1
     buckle = bisect(buckled, float(values[j]), states[j], float(values[j + 1]))
     return lift, buckle
+
+
+def _rise(floor: Floor, lattice: Lattice, positions: FloatArray) -> float:
+    """Largest rise of a node above its printed height over ``floor`` (mm)."""
+    return float((floor.height_of(positions) - floor.height_of(lattice.network.nodes)).max())
 
 
 def _laid_on(state: State, floor: Floor, height: float, flip: bool) -> State:

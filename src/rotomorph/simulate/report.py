@@ -339,47 +339,26 @@ def _lattice_section(
         if quick and pattern in ("expanding", "contracting"):
             fine[pattern] = _heat(pattern, quick, steps, model, fine_g)[1]
         tick()
+
     # contact-resolved ramps: self-contact, resting on the bath floor under buoyant weight.
     # These are the physical states, so the counted areas come from them (at two resolutions).
     # Left out in quick mode, whose 3 x 3 smoke run must stay fast: its rows come from the
     # ramps without contact and say so.
+    def on_floor(pattern: str, ghosts: int) -> tuple[Any, Any, str]:
+        lift_tol = LIFT_OFF_TOLERANCE if pattern in ("dome", "saddle") else None
+        return _heat(pattern, quick, steps, model, ghosts, True, lift_off_tolerance=lift_tol)
+
     resolved = (
         {}
         if quick
-        else {
-            p: _heat(
-                p,
-                quick,
-                steps,
-                model,
-                coarse_g,
-                contact=True,
-                lift_off_tolerance=LIFT_OFF_TOLERANCE if p in ("dome", "saddle") else None,
-            )
-            for p in ("expanding", "contracting", "dome", "saddle")
-        }
+        else {p: on_floor(p, coarse_g) for p in ("expanding", "contracting", "dome", "saddle")}
     )
     if not quick:
         for pattern in ("expanding", "contracting"):
-            fine[pattern] = _heat(pattern, quick, steps, model, fine_g, contact=True)[1]
+            fine[pattern] = on_floor(pattern, fine_g)[1]
     # dome and saddle at the finer resolution too: their counted sign, curvature and lift-off
     # come from it, the coarser one is the convergence check
-    surfaces = (
-        {}
-        if quick
-        else {
-            p: _heat(
-                p,
-                quick,
-                steps,
-                model,
-                fine_g,
-                contact=True,
-                lift_off_tolerance=LIFT_OFF_TOLERANCE,
-            )
-            for p in ("dome", "saddle")
-        }
-    )
+    surfaces = {} if quick else {p: on_floor(p, fine_g) for p in ("dome", "saddle")}
     # Fig. 3G: area
     fig = new_figure(6.0, 4.2)
     ax = fig.add_subplot()
