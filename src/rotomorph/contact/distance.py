@@ -45,6 +45,14 @@ def _clamp01(v):  # pragma: no cover - compiled
 @njit(cache=True)
 def closest_parameters(p0, p1, q0, q1):  # pragma: no cover - compiled
     """Closest-point parameters ``(s, t)`` of segments ``p0p1`` and ``q0q1`` (each in [0, 1])."""
+    A, B, C, E, F, R = _gram(p0, p1, q0, q1)
+    return _closest_gram(A, B, C, E, F, R)
+
+
+@njit(cache=True)
+def _gram(p0, p1, q0, q1):  # pragma: no cover - compiled
+    """Gram entries ``(A, B, C, E, F, R)`` of :func:`_closest_gram` from the end points (3-arrays
+    or 3-tuples)."""
     A = 0.0
     B = 0.0
     C = 0.0
@@ -61,7 +69,7 @@ def closest_parameters(p0, p1, q0, q1):  # pragma: no cover - compiled
         C += a * r
         E += b * b
         F += b * r
-    return _closest_gram(A, B, C, E, F, R)
+    return A, B, C, E, F, R
 
 
 @njit(cache=True)
@@ -71,34 +79,24 @@ def pair_distance2(x, i0, i1, j0, j1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _moved(x, dx, t, i):  # pragma: no cover - compiled
+    """Node ``i`` of ``x + t dx`` as a 3-tuple (no allocation)."""
+    return (x[i, 0] + t * dx[i, 0], x[i, 1] + t * dx[i, 1], x[i, 2] + t * dx[i, 2])
+
+
+@njit(cache=True)
 def moving_distance2(x, dx, t, i0, i1, j0, j1):  # pragma: no cover - compiled
     """Squared distance of the segments of ``x + t dx`` (no allocation)."""
-    A = 0.0
-    B = 0.0
-    C = 0.0
-    E = 0.0
-    F = 0.0
-    R = 0.0
-    for k in range(3):
-        p0 = x[i0, k] + t * dx[i0, k]
-        q0 = x[j0, k] + t * dx[j0, k]
-        a = x[i1, k] + t * dx[i1, k] - p0
-        b = x[j1, k] + t * dx[j1, k] - q0
-        r = p0 - q0
-        R += r * r
-        A += a * a
-        B += a * b
-        C += a * r
-        E += b * b
-        F += b * r
-    s, u = _closest_gram(A, B, C, E, F, R)
+    p0 = _moved(x, dx, t, i0)
+    p1 = _moved(x, dx, t, i1)
+    q0 = _moved(x, dx, t, j0)
+    q1 = _moved(x, dx, t, j1)
+    s, u = closest_parameters(p0, p1, q0, q1)
     D = 0.0
     for k in range(3):
-        p0 = x[i0, k] + t * dx[i0, k]
-        q0 = x[j0, k] + t * dx[j0, k]
-        a = x[i1, k] + t * dx[i1, k] - p0
-        b = x[j1, k] + t * dx[j1, k] - q0
-        r = p0 + s * a - q0 - u * b
+        a = p1[k] - p0[k]
+        b = q1[k] - q0[k]
+        r = p0[k] + s * a - q0[k] - u * b
         D += r * r
     return D
 
