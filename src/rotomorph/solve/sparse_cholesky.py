@@ -35,6 +35,10 @@ class Symbolic:
     diag_src: IntArray  # position of B's diagonal entries in the data array of A (per column)
     parent: IntArray  # elimination tree
     lp: IntArray  # column pointers of L
+    li: IntArray  # row indices of L (fixed by the pattern; shared by every numeric factor)
+    rp: IntArray  # row k of L (off the diagonal) is rows[rp[k]:rp[k + 1]] ...
+    rows: IntArray  # ... its columns in the topological order of the elimination tree
+    slot: IntArray  # position in L's arrays of each of those entries
 
 
 @njit(cache=True)
@@ -89,37 +93,64 @@ def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _numeric(n, bp, bi, bx, shift, parent, lp, li, lx):  # pragma: no cover - compiled
-    """Up-looking Cholesky of B + diag(shift); False at a non-positive pivot."""
+def _row_patterns(n, bp, bi, parent, lp):  # pragma: no cover - compiled
+    """Row indices ``li`` of L and the pattern of every row of L in the order the up-looking
+    factorization visits it (``cs_ereach``): ``rows[rp[k]:rp[k + 1]]`` with the ``slot`` of
+    each entry in L's arrays. Both depend on the pattern only, so every numeric factorization
+    of it reuses them instead of walking the elimination tree again."""
+    nnz = lp[n]
+    li = np.empty(nnz, dtype=np.int64)
+    rp = np.empty(n + 1, dtype=np.int64)
+    rows = np.empty(nnz - n, dtype=np.int64)
+    slot = np.empty(nnz - n, dtype=np.int64)
     c = lp[:-1].copy()
-    x = np.zeros(n)
     s = np.empty(n, dtype=np.int64)
     w = -np.ones(n, dtype=np.int64)
+    m = 0
     for k in range(n):
+        rp[k] = m
         top = _ereach(k, bp, bi, parent, s, w)
+        for t in range(top, n):
+            i = s[t]
+            rows[m] = i
+            slot[m] = c[i]
+            li[c[i]] = k
+            c[i] += 1
+            m += 1
+        li[c[k]] = k
+        c[k] += 1
+    rp[n] = m
+    return li, rp, rows, slot
+
+
+@njit(cache=True)
+def _numeric(n, bp, bi, bx, shift, lp, li, rp, rows, slot, lx):  # pragma: no cover - compiled
+    """Up-looking Cholesky of B + diag(shift) into ``lx``; False at a non-positive pivot.
+
+    Row k: ``L[k, :k]`` solves ``L[:k, :k] y = B[:k, k]`` over the row's pattern (in
+    elimination-tree order), then ``L[k, k] = sqrt(B[k, k] - y.y)``. The operations and their
+    order are those of CSparse's ``cs_chol``, with the pattern precomputed.
+    """
+    x = np.zeros(n)
+    for k in range(n):
         for p in range(bp[k], bp[k + 1]):
             i = bi[p]
             if i <= k:
                 x[i] = bx[p]
         d = x[k] + shift[k]
         x[k] = 0.0
-        for t in range(top, n):
-            i = s[t]
+        for t in range(rp[k], rp[k + 1]):
+            i = rows[t]
             lki = x[i] / lx[lp[i]]
             x[i] = 0.0
-            for p in range(lp[i] + 1, c[i]):
+            end = slot[t]
+            for p in range(lp[i] + 1, end):
                 x[li[p]] -= lx[p] * lki
             d -= lki * lki
-            p = c[i]
-            c[i] += 1
-            li[p] = k
-            lx[p] = lki
+            lx[end] = lki
         if not d > 0.0:
             return False
-        p = c[k]
-        c[k] += 1
-        li[p] = k
-        lx[p] = np.sqrt(d)
+        lx[lp[k]] = np.sqrt(d)
     return True
 
 
@@ -172,7 +203,11 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     parent = _etree(n, bp, bi)
     counts = _column_counts(n, bp, bi, parent)
     lp = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-    return Symbolic(n=n, perm=perm, bp=bp, bi=bi, src=src, diag_src=diag_src, parent=parent, lp=lp)
+    li, rp, rows, slot = _row_patterns(n, bp, bi, parent, lp)
+    return Symbolic(
+        n=n, perm=perm, bp=bp, bi=bi, src=src, diag_src=diag_src, parent=parent, lp=lp, li=li,
+        rp=rp, rows=rows, slot=slot,
+    )  # fmt: skip
 
 
 def ordering(A: sp.csc_matrix) -> IntArray:
@@ -190,13 +225,13 @@ def ordering(A: sp.csc_matrix) -> IntArray:
 class SparseCholesky:
     """Numeric factor of ``A + diag(shift)`` with a cached :class:`Symbolic`; ``solve(b)``."""
 
-    def __init__(self, sym: Symbolic, li: IntArray, lx: FloatArray) -> None:
-        self._sym, self._li, self._lx = sym, li, lx
+    def __init__(self, sym: Symbolic, lx: FloatArray) -> None:
+        self._sym, self._lx = sym, lx
 
     def solve(self, b: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
         s = self._sym
-        return _solve(s.n, s.lp, self._li, self._lx, s.perm, np.ascontiguousarray(b, float))
+        return _solve(s.n, s.lp, s.li, self._lx, s.perm, np.ascontiguousarray(b, float))
 
 
 def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky | None:
@@ -204,10 +239,8 @@ def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky
 
     Returns ``None`` when it is not positive definite.
     """
-    nnz = int(sym.lp[-1])
-    li = np.empty(nnz, dtype=np.int64)
-    lx = np.empty(nnz)
+    lx = np.empty(int(sym.lp[-1]))
     bx = np.ascontiguousarray(data[sym.src])
     sh = np.ascontiguousarray(np.broadcast_to(shift, (sym.n,)), dtype=float)[sym.perm]
-    ok = _numeric(sym.n, sym.bp, sym.bi, bx, sh, sym.parent, sym.lp, li, lx)
-    return SparseCholesky(sym, li, lx) if ok else None
+    ok = _numeric(sym.n, sym.bp, sym.bi, bx, sh, sym.lp, sym.li, sym.rp, sym.rows, sym.slot, lx)
+    return SparseCholesky(sym, lx) if ok else None
