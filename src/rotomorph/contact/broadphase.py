@@ -22,17 +22,30 @@ __all__ = ["near_pairs"]
 
 
 @njit(cache=True)
-def _is_excluded(keys, a, b, ne):  # pragma: no cover - compiled
-    """Whether segments ``a`` and ``b`` may not touch (the same segment or a key in ``keys``)."""
+def _key_rows(keys, ne):  # pragma: no cover - compiled
+    """Row pointers of the sorted keys ``lo * ne + hi`` by ``lo``: the keys of segment ``lo``
+    are ``keys[ptr[lo]:ptr[lo + 1]]``."""
+    ptr = np.zeros(ne + 1, dtype=np.int64)
+    for t in range(keys.shape[0]):
+        ptr[keys[t] // ne + 1] += 1
+    for e in range(ne):
+        ptr[e + 1] += ptr[e]
+    return ptr
+
+
+@njit(cache=True)
+def _excluded_in_row(keys, ptr, a, b, ne):  # pragma: no cover - compiled
+    """Whether segments ``a`` and ``b`` may not touch (the same segment or a key in ``keys``),
+    by a scan of the (few) keys of the lower one."""
     lo = min(a, b)
     hi = max(a, b)
     if lo == hi:
         return True
-    if keys.shape[0] == 0:
-        return False
     k = lo * ne + hi
-    i = np.searchsorted(keys, k)
-    return i < keys.shape[0] and keys[i] == k
+    for t in range(ptr[lo], ptr[lo + 1]):
+        if keys[t] >= k:
+            return keys[t] == k
+    return False
 
 
 @njit(cache=True)
@@ -74,38 +87,57 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
             widest, axis = w, k
     start = lo[:, axis] - share
     order = np.argsort(start)
+    ptr = _key_rows(keys, ne)
+    # the boxes in sweep order, contiguous (the inner loop reads them in that order)
+    lo_s = np.empty((m, 3))
+    hi_s = np.empty((m, 3))
+    share_s = np.empty(m)
+    start_s = np.empty(m)
+    for ii in range(m):
+        i = order[ii]
+        for k in range(3):
+            lo_s[ii, k] = lo[i, k]
+            hi_s[ii, k] = hi[i, k]
+        share_s[ii] = share[i]
+        start_s[ii] = start[i]
     seg = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
     node = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
     ns = np.int64(0)  # not the literal 0: one compiled _grow, not one per literal
     nq = np.int64(0)
     for ii in range(m):
         i = order[ii]
-        end = hi[i, axis] + share[i]
+        end = hi_s[ii, axis] + share_s[ii]
+        i_node = i >= ne
         for jj in range(ii + 1, m):
-            j = order[jj]
-            if start[j] > end:
+            if start_s[jj] > end:
                 break
-            if i >= ne and j >= ne:
+            j = order[jj]
+            if i_node and j >= ne:
                 continue  # node against node: carried by the segments
-            reach = share[i] + share[j]
+            reach = share_s[ii] + share_s[jj]
+            # a gap along one axis of at least the reach rejects the pair (then g2 >= reach^2)
             g2 = 0.0
+            far = False
             for k in range(3):
-                g = max(lo[j, k] - hi[i, k], lo[i, k] - hi[j, k], 0.0)
+                g = max(lo_s[jj, k] - hi_s[ii, k], lo_s[ii, k] - hi_s[jj, k], 0.0)
+                if g >= reach:
+                    far = True
+                    break
                 g2 += g * g
-            if g2 >= reach * reach:
+            if far or g2 >= reach * reach:
                 continue
-            if i < ne and j < ne:
-                if not _is_excluded(keys, i, j, ne):
+            if not i_node and j < ne:
+                if not _excluded_in_row(keys, ptr, i, j, ne):
                     seg = _grow(seg, ns)
                     seg[ns, 0] = min(i, j)
                     seg[ns, 1] = max(i, j)
                     ns += 1
                 continue
-            n, e = (i - ne, j) if i >= ne else (j - ne, i)
+            n, e = (i - ne, j) if i_node else (j - ne, i)
             ok = True
             for c in range(incident.shape[1]):
                 f = incident[n, c]
-                if f >= 0 and _is_excluded(keys, f, e, ne):
+                if f >= 0 and _excluded_in_row(keys, ptr, f, e, ne):
                     ok = False
                     break
             if ok:
