@@ -81,7 +81,10 @@ class HessianPattern:
             pos = np.searchsorted(keys, ckeys)
         data = np.zeros(len(keys))
         data[self._base_pos] = base.data
-        np.add.at(data, pos, c.data)
+        if contact.format == "csc" and contact.has_canonical_format:
+            data[pos] += c.data  # one entry per position: the same sums as np.add.at, faster
+        else:
+            np.add.at(data, pos, c.data)
         assert self._union is not None and self._sym is not None
         indices, indptr = self._union
         return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)

@@ -14,6 +14,7 @@ pattern.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -35,10 +36,15 @@ class Symbolic:
     diag_src: IntArray  # position of B's diagonal entries in the data array of A (per column)
     parent: IntArray  # elimination tree
     lp: IntArray  # column pointers of L
-    li: IntArray  # row indices of L (fixed by the pattern; shared by every numeric factor)
-    rp: IntArray  # row k of L (off the diagonal) is rows[rp[k]:rp[k + 1]] ...
-    rows: IntArray  # ... its columns in the topological order of the elimination tree
-    slot: IntArray  # position in L's arrays of each of those entries
+
+    @cached_property
+    def row_pattern(self) -> tuple[IntArray, IntArray, IntArray, IntArray]:
+        """``li, rp, rows, slot``: the row indices of L (fixed by the pattern, shared by every
+        numeric factor) and row k of L off the diagonal, ``rows[rp[k]:rp[k + 1]]``, in the
+        topological order of the elimination tree with the position (``slot``) of each entry
+        in L's arrays; found at the first factorization (a pattern analysed only to measure
+        its fill is never factored)."""
+        return _row_patterns(self.n, self.bp, self.bi, self.parent, self.lp)  # type: ignore[no-any-return]
 
 
 @njit(cache=True)
@@ -203,11 +209,7 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     parent = _etree(n, bp, bi)
     counts = _column_counts(n, bp, bi, parent)
     lp = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-    li, rp, rows, slot = _row_patterns(n, bp, bi, parent, lp)
-    return Symbolic(
-        n=n, perm=perm, bp=bp, bi=bi, src=src, diag_src=diag_src, parent=parent, lp=lp, li=li,
-        rp=rp, rows=rows, slot=slot,
-    )  # fmt: skip
+    return Symbolic(n=n, perm=perm, bp=bp, bi=bi, src=src, diag_src=diag_src, parent=parent, lp=lp)
 
 
 def ordering(A: sp.csc_matrix) -> IntArray:
@@ -231,7 +233,7 @@ class SparseCholesky:
     def solve(self, b: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
         s = self._sym
-        return _solve(s.n, s.lp, s.li, self._lx, s.perm, np.ascontiguousarray(b, float))
+        return _solve(s.n, s.lp, s.row_pattern[0], self._lx, s.perm, np.ascontiguousarray(b, float))
 
 
 def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky | None:
@@ -242,5 +244,5 @@ def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky
     lx = np.empty(int(sym.lp[-1]))
     bx = np.ascontiguousarray(data[sym.src])
     sh = np.ascontiguousarray(np.broadcast_to(shift, (sym.n,)), dtype=float)[sym.perm]
-    ok = _numeric(sym.n, sym.bp, sym.bi, bx, sh, sym.lp, sym.li, sym.rp, sym.rows, sym.slot, lx)
+    ok = _numeric(sym.n, sym.bp, sym.bi, bx, sh, sym.lp, *sym.row_pattern, lx)
     return SparseCholesky(sym, lx) if ok else None
