@@ -17,7 +17,10 @@ Predictions are leave-one-group-out (:mod:`rotomorph.simulate.validation`): each
 measurements is predicted by the model calibrated without it; rows that are fits or inputs have
 ``calibration = true`` and are never counted. Every number is computed at two resolutions; the
 report fails loudly (:class:`~rotomorph.errors.ConvergenceError`, after writing everything) when
-a number is not converged to 1 % unless ``allow_unconverged``.
+a number is not converged to 1 % unless ``allow_unconverged``. Every contact-resolved lattice
+ramp is also run in :data:`PATH_CHECK_FACTOR` times the steps; where the two end in different
+stable states (a multistable lattice), the one lower in total energy is counted
+(:func:`lower_energy_end`) and the row's note gives both.
 
 Sections: Janus curvature vs speed (Fig. 2D), L/L0 vs ω* (Fig. 2F/G), sinusoidal filaments
 (Fig. 3C/D), lattice areas (Fig. 3G), dome and saddle lattices (Fig. 4). A lattice part that
@@ -51,6 +54,7 @@ from rotomorph.simulate.report_shapes import (
     lattice_tube_figure,
 )
 from rotomorph.simulate.validation import (
+    CONVERGENCE_RTOL,
     FILAMENT_SPACINGS,
     SINUSOID_DESIGN,
     Validation,
@@ -244,11 +248,55 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 LATTICE_GHOSTS = {True: (6, 12), False: (10, 20)}
 #: Heating steps of the full lattice ramps.
 LATTICE_STEPS = 8
+#: Every contact-resolved lattice ramp is also run with this many times the steps: a lattice
+#: with several stable states can end in a different one when the path changes (path
+#: dependence), and then the end state lower in total energy is counted.
+PATH_CHECK_FACTOR = 2
+#: Relative difference of total energy below which two ramps ended in the same state.
+SAME_STATE_RTOL = 1e-6
 #: Width (°C) to which the dome's and saddle's lift-off and weightless buckling are bisected.
 LIFT_OFF_TOLERANCE = 0.5
 #: Heating steps of the perturbed ramps that propagate the calibration's uncertainty (the
-#: final state of an elastic ramp does not depend on the steps once each converges).
+#: secants compare ramps of the same steps, without contact: no lift-off, no jamming).
 SD_STEPS = 4
+
+
+def lower_energy_end(first: Any, second: Any) -> tuple[int, str]:
+    """Which of two ramps of one lattice to count, and a note saying why.
+
+    ``first`` and ``second`` are :class:`~rotomorph.lattice.heating.HeatingResult` objects of
+    the same lattice, model, floor and weight, ramped in different numbers of steps (``None``
+    for a failed ramp). Both end at the same temperature, so their total energies (elastic +
+    weight + barrier) compare. Returns ``(0 or 1, note)``: the first unless the second ends
+    in a different state that is certified stable, free of interpenetration and lower in
+    total energy (the lowest-energy choice of the floor's lift probe, applied to the path).
+    """
+
+    def describe(res: Any) -> str:
+        return (
+            f"{len(res.parameter) - 1} steps: total energy {float(res.energy[-1]):.6g} N mm, "
+            f"sign {int(res.gaussian_sign[-1]):+d}, A/A0 {float(res.final_area_ratio):.4g}"
+        )
+
+    if second is None:
+        return 0, "path check: the ramp with more steps failed"
+    if first is None:
+        return 1, "path check: only the ramp with more steps converged"
+    e1, e2 = float(first.energy[-1]), float(second.energy[-1])
+    if abs(e2 - e1) <= SAME_STATE_RTOL * max(abs(e1), abs(e2), 1e-300):
+        return 0, (
+            f"path check: the ramp in {len(second.parameter) - 1} steps ends in the same state"
+        )
+    admissible = bool(second.stable[-1]) and float(np.min(second.min_clearance)) >= 0.999
+    pick = 1 if admissible and e2 < e1 else 0
+    return pick, (
+        "path check: the ramps end in different stable states ("
+        + describe(first)
+        + "; "
+        + describe(second)
+        + "); the lattice is multistable and the one lower in total energy is counted ("
+        + f"{len((first, second)[pick].parameter) - 1} steps)"
+    )
 
 
 def _heat(
@@ -344,9 +392,25 @@ def _lattice_section(
     # These are the physical states, so the counted areas come from them (at two resolutions).
     # Left out in quick mode, whose 3 x 3 smoke run must stay fast: its rows come from the
     # ramps without contact and say so.
+    paths_checked: dict[tuple[str, int], str] = {}
+
     def on_floor(pattern: str, ghosts: int) -> tuple[Any, Any, str]:
         lift_tol = LIFT_OFF_TOLERANCE if pattern in ("dome", "saddle") else None
-        return _heat(pattern, quick, steps, model, ghosts, True, lift_off_tolerance=lift_tol)
+        first = _heat(pattern, quick, steps, model, ghosts, True, lift_off_tolerance=lift_tol)
+        more = PATH_CHECK_FACTOR * steps
+        check = _heat(pattern, quick, more, model, ghosts, True)
+        pick, paths_checked[pattern, ghosts] = lower_energy_end(first[1], check[1])
+        if pick == 0:
+            return first
+        # the counted ramp also bisects its lift-off (the same ramp, cached separately)
+        return _heat(pattern, quick, more, model, ghosts, True, lift_off_tolerance=lift_tol)
+
+    def path_note(pattern: str) -> str:
+        return "; ".join(
+            f"{g} ghost nodes per edge, {paths_checked[pattern, g]}"
+            for g in (coarse_g, fine_g)
+            if (pattern, g) in paths_checked
+        )
 
     resolved = (
         {}
@@ -356,6 +420,26 @@ def _lattice_section(
     if not quick:
         for pattern in ("expanding", "contracting"):
             fine[pattern] = on_floor(pattern, fine_g)[1]
+    # a counted area not converged to 1 % between the two resolutions is refined once more
+    # (twice the finer ghost count) and counted there, with the finer of the first pair as
+    # its convergence check
+    pairs: dict[str, tuple[int, int, float | None]] = {}
+    for pattern in ("expanding", "contracting"):
+        lo_res = results[pattern][1] if quick else resolved[pattern][1]
+        hi_res = fine[pattern]
+        pairs[pattern] = (
+            coarse_g,
+            fine_g,
+            None if lo_res is None else float(lo_res.final_area_ratio),
+        )
+        if quick or lo_res is None or hi_res is None:
+            continue
+        a_lo, a_hi = float(lo_res.final_area_ratio), float(hi_res.final_area_ratio)
+        if abs(a_hi - a_lo) > CONVERGENCE_RTOL * abs(a_hi):
+            finer = on_floor(pattern, 2 * fine_g)[1]
+            if finer is not None:
+                fine[pattern] = finer
+                pairs[pattern] = (fine_g, 2 * fine_g, a_hi)
     # dome and saddle at the finer resolution too: their counted sign, curvature and lift-off
     # come from it, the coarser one is the convergence check
     surfaces = {} if quick else {p: on_floor(p, fine_g) for p in ("dome", "saddle")}
@@ -365,7 +449,6 @@ def _lattice_section(
     for i, pattern in enumerate(("expanding", "contracting")):
         lattice, res, why = results[pattern]
         touched = resolved.get(pattern, (None, None, ""))[1]
-        counted_res = res if quick else touched
         measured = 1.0 + float(table.value[i]) / 100.0
         spread = float(table.spread[i]) / 100.0
         if quick:
@@ -387,7 +470,8 @@ def _lattice_section(
                     else f" (left the floor at {touched.first_lift_off():.4g} °C: the lifted "
                     "equilibrium is lower in energy than the resting one)"
                 )
-                + "; sd propagated through the same lattice without contact"
+                + "; sd propagated through the same lattice without contact; "
+                + path_note(pattern)
                 if touched is not None
                 else ""
             )
@@ -401,8 +485,8 @@ def _lattice_section(
                 predicted_sd=None
                 if quick or res is None
                 else _area_sd(fit, pattern, quick, coarse_g),
-                other=None if counted_res is None else counted_res.final_area_ratio,
-                resolution=(coarse_g, fine_g),
+                other=pairs[pattern][2],
+                resolution=pairs[pattern][:2],
                 resolution_unit="ghost nodes per edge",
                 calibrated_without="lattice_area (never fitted)",
                 unit="1",
@@ -535,7 +619,7 @@ def _lattice_section(
                 + (
                     "contact-resolved on the bath floor under buoyant weight (min clearance "
                     f"{np.min(res.min_clearance):.3f}); first rises one diameter off the floor "
-                    f"at {res.first_lift_off()}"
+                    f"at {res.first_lift_off()}; {path_note(pattern)}"
                     if res.contact is not None
                     else "quick mode: no contact (min clearance "
                     f"{np.min(res.min_clearance):.2f} diameters)"
