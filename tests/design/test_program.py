@@ -28,6 +28,28 @@ def test_fixed_nozzle_on_a_circle_turns_the_interface_with_the_heading():
     np.testing.assert_allclose(prog.interface_angle, path.heading - 0.3, atol=1e-12)
 
 
+@pytest.mark.parametrize("angle", [1.5, -1.5])
+def test_fixed_nozzle_on_an_arc_winds_minus_r_over_r_arc_at_every_vertex(angle):
+    # the ends included: their vertex headings are the end edges' (one-sided), which alone
+    # would give the first and last vertices half and the next ones three quarters of it
+    r_arc = 4.0
+    path = Path.from_segments([Arc(r_arc, angle)], spacing=0.05)
+    fixed = PrintProgram.from_rotation(path, 3.0, 0.0)
+    omega_star = fixed.radius * fixed.director_rotation / fixed.speed
+    # chords of a uniformly sampled arc: Δ/chord = (1 + Δ²/24 + ...) / r_arc, Δ = 0.0125
+    np.testing.assert_allclose(omega_star, -np.sign(angle) * fixed.radius / r_arc, rtol=1e-5)
+    # a nozzle that tracks the heading winds nothing, ends included
+    tracking = PrintProgram.from_interface_angle(path, 3.0, 0.4)
+    assert np.all(tracking.director_rotation == 0.0)
+
+
+def test_straight_path_director_rotation_is_the_nozzle_rotation_ends_included():
+    # a rotation that changes along the path: the end vertices keep their own rates
+    path = Path.line((0, 0, 0), (3, 4, 0), 0.1)
+    prog = PrintProgram.from_rotation(path, 2.0, lambda s: 1.0 + 0.8 * s)
+    np.testing.assert_allclose(prog.director_rotation, prog.rotation, rtol=1e-12)
+
+
 def test_interface_normal_sign_convention():
     # nozzle normal along lab +y on a path along +x: lands on the left side (n = -d2, α = -π/2)
     prog = PrintProgram(Path.line((0, 0, 0), (1, 0, 0), 0.5).points, 1.0, np.pi / 2)

@@ -213,6 +213,15 @@ class PrintProgram:
         curved path (the active half kept on one side) winds no helix. With ``step_flips``
         the ideal flips (interface-angle changes of π/2 or more over one edge) have zero
         length and wind none either.
+
+        The heading ψ at a vertex is the mean of its two edges' headings, the tangent of the
+        curve through it; an end vertex has only its edge's, which lags the tangent of a
+        curved path by half the neighbour's turn. Where the path curves at an end (the
+        neighbour's curvature is 1e-9 /mm or more) the first (last) two vertices, whose
+        differences include that heading, continue the rate per length of the third (third
+        from last) vertex: a fixed nozzle on an arc winds ω* = −R κ at every vertex, a
+        tracking one nothing, and straight ends keep their own rates. The nozzle angles (and
+        the G-code) are not changed.
         """
         psi = _vertex_heading(self.path)
         d_rel = np.diff(self.nozzle_angle - psi)
@@ -222,7 +231,14 @@ class PrintProgram:
         if self.step_flips:
             d_rel = np.where(np.abs(d_rel) >= 0.5 * np.pi - 1e-9, 0.0, d_rel)
         relative = np.concatenate([[0.0], np.cumsum(d_rel)])
-        return self.speed * np.gradient(relative, self.arc_length)
+        per_length = np.gradient(relative, self.arc_length)
+        if len(per_length) >= 5:  # a third vertex whose differences use bisector headings
+            kappa = self.path.curvature
+            if abs(kappa[1]) >= _ZERO_CURVATURE:
+                per_length[:2] = per_length[2]
+            if abs(kappa[-2]) >= _ZERO_CURVATURE:
+                per_length[-2:] = per_length[-3]
+        return self.speed * per_length
 
     @property
     def rotation_number(self) -> FloatArray:
