@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from rotomorph.contact.distance import pair_distance2, segment_distance2
+from rotomorph.contact.psd import psd_project
 
 
 @njit(cache=True)
@@ -37,26 +38,6 @@ def barrier(z, zhat):  # pragma: no cover - compiled
     b1 = -2.0 * dz * lg - dz * dz / z
     b2 = -2.0 * lg - 4.0 * dz / z + dz * dz / (z * z)
     return b, b1, b2
-
-
-@njit(cache=True)
-def _psd_project(h, out):  # pragma: no cover - compiled
-    """``out`` = ``h`` with its negative eigenvalues dropped (``out`` may be ``h`` itself).
-
-    Loops, not ``out += vals[k] * np.outer(v, v)`` into a returned array: array expressions and
-    row assignments make numba compile shape checks with formatted messages (~5 s on the first
-    run); the arithmetic is the same, in the same order.
-    """
-    vals, vecs = np.linalg.eigh(h)
-    n = vals.shape[0]
-    for i in range(n):
-        for j in range(n):
-            out[i, j] = 0.0
-    for k in range(n):
-        if vals[k] > 0.0:
-            for i in range(n):
-                for j in range(n):
-                    out[i, j] += vals[k] * (vecs[i, k] * vecs[j, k])
 
 
 @njit(cache=True)
@@ -126,6 +107,9 @@ def pair_barrier(
     h = np.empty((12, 12))
     gx = np.empty(12)
     hx = np.empty((12, 12))
+    vecs = np.empty((12, 12))  # work arrays of the projection
+    vals = np.empty(12)
+    off = np.empty(12)
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
         D = pair_distance2(x, i0, i1, j0, j1)
@@ -167,7 +151,7 @@ def pair_barrier(
                         v += b * (m2 * gx[i] * gx[j] + m1 * hx[i, j])
                     hloc[p, i, j] = c * v
             if need_hess == 2:
-                _psd_project(hloc[p], hloc[p])
+                psd_project(hloc[p], hloc[p], vecs, vals, off)
     return energy
 
 
