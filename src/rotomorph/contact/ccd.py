@@ -42,12 +42,18 @@ def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragm
     first = np.empty(P)
     for p in range(P):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
-        m = (dx[i0] + dx[i1] + dx[j0] + dx[j1]) / 4.0
+        # scalars, not array expressions (those allocate temporaries per pair)
+        m0 = (dx[i0, 0] + dx[i1, 0] + dx[j0, 0] + dx[j1, 0]) / 4.0
+        m1 = (dx[i0, 1] + dx[i1, 1] + dx[j0, 1] + dx[j1, 1]) / 4.0
+        m2 = (dx[i0, 2] + dx[i1, 2] + dx[j0, 2] + dx[j1, 2]) / 4.0
         lp = 0.0
         lq = 0.0
         for n in range(4):
-            v = dx[pairs[p, n]] - m
-            ln = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            k = pairs[p, n]
+            v0 = dx[k, 0] - m0
+            v1 = dx[k, 1] - m1
+            v2 = dx[k, 2] - m2
+            ln = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
             if n < 2:
                 lp = max(lp, ln)
             else:
