@@ -34,7 +34,7 @@ from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["Contact", "ContactPotential", "InfeasibleContactError"]
+__all__ = ["Contact", "ContactPotential", "HessianBlocks", "InfeasibleContactError"]
 
 #: barrier force of a pair at half the activation distance, in units of the reference force
 ACTIVATION_FORCE = 1.0
@@ -157,6 +157,38 @@ class _Candidates:
     @property
     def floor_dmin(self) -> FloatArray:
         return np.concatenate([f[1] for f in self.floors]) if self.floors else np.zeros(0)
+
+
+@dataclass(frozen=True, eq=False)
+class HessianBlocks:
+    """The contact Hessian as local blocks on node coordinates ``3 i + k``.
+
+    ``pair[p]`` (12 x 12) couples the nodes ``quads[p]`` (indices of the extended point array:
+    those ``>= n_nodes`` are fixed obstacle points and carry no unknowns); ``node[q]`` (3 x 3)
+    is the floor block of node ``nodes[q]``.
+    """
+
+    n_nodes: int
+    quads: IntArray  # (P, 4)
+    pair: FloatArray  # (P, 12, 12)
+    nodes: IntArray  # (Q,)
+    node: FloatArray  # (Q, 3, 3)
+
+    def triplets(self) -> tuple[IntArray, IntArray, FloatArray]:
+        """Rows, columns and values of the non-zero entries on the network's coordinates."""
+        n3 = 3 * self.n_nodes
+        dof = (self.quads[:, :, None] * 3 + np.arange(3)).reshape(-1, 12)
+        rows = np.repeat(dof, 12, axis=1).ravel()
+        cols = np.tile(dof, (1, 12)).ravel()
+        vals = self.pair.reshape(-1)
+        fdof = (self.nodes[:, None] * 3 + np.arange(3)).reshape(-1, 3)
+        frows = np.repeat(fdof, 3, axis=1).ravel()
+        fcols = np.tile(fdof, (1, 3)).ravel()
+        rows = np.concatenate([rows, frows])
+        cols = np.concatenate([cols, fcols])
+        vals = np.concatenate([vals, self.node.reshape(-1)])
+        keep = (rows < n3) & (cols < n3) & (vals != 0)
+        return rows[keep], cols[keep], vals[keep]
 
 
 class ContactPotential:
@@ -409,6 +441,13 @@ class ContactPotential:
         ``need_hess``: 0 none, 1 exact, 2 projected to positive semidefinite per pair. The energy
         is inf (and no derivatives are returned) when anything touches or interpenetrates.
         """
+        energy, g, blocks = self.evaluate_blocks(x, need_grad, need_hess)
+        return energy, g, None if blocks is None else blocks.triplets()
+
+    def evaluate_blocks(
+        self, x: FloatArray, need_grad: bool, need_hess: int
+    ) -> tuple[float, FloatArray | None, HessianBlocks | None]:
+        """:meth:`evaluate` with the Hessian as its local blocks (:class:`HessianBlocks`)."""
         x = np.ascontiguousarray(x, dtype=float)
         cand = self.candidates(x)
         xe = self._extended(x)
@@ -442,42 +481,25 @@ class ContactPotential:
             energy += e
             blocks.append(blk)
         fl_h = np.concatenate(blocks) if blocks else np.zeros((0, 3, 3))
-        extra_quads = extra_h = None
         if self._lag is not None:
             ef, gf, hf = friction_energy(self._lag, xe, need_grad, bool(need_hess))
             energy += ef
             if gf is not None:
                 grad += gf
-            extra_quads, extra_h = self._lag.nodes, hf
+            if need_hess and hf is not None and len(self._lag.nodes):
+                quads = np.concatenate([quads, self._lag.nodes])
+                hloc = np.concatenate([hloc, hf])
         g = grad[: self.n_nodes] if need_grad else None
-        hess = self._triplets(quads, hloc, cand, fl_h, extra_quads, extra_h) if need_hess else None
+        hess = None
+        if need_hess:
+            hess = HessianBlocks(
+                n_nodes=self.n_nodes,
+                quads=np.ascontiguousarray(quads, dtype=np.int64),
+                pair=np.ascontiguousarray(hloc),
+                nodes=np.ascontiguousarray(cand.floor_nodes, dtype=np.int64),
+                node=np.ascontiguousarray(fl_h),
+            )
         return float(energy), g, hess
-
-    def _triplets(
-        self,
-        quads: IntArray,
-        hloc: FloatArray,
-        cand: _Candidates,
-        fl_h: FloatArray,
-        extra_quads: IntArray | None = None,
-        extra_h: FloatArray | None = None,
-    ) -> tuple[IntArray, IntArray, FloatArray]:
-        n3 = 3 * self.n_nodes
-        if extra_quads is not None and extra_h is not None and len(extra_quads):
-            quads = np.concatenate([quads, extra_quads])
-            hloc = np.concatenate([hloc, extra_h])
-        dof = (quads[:, :, None] * 3 + np.arange(3)).reshape(-1, 12)
-        rows = np.repeat(dof, 12, axis=1).ravel()
-        cols = np.tile(dof, (1, 12)).ravel()
-        vals = hloc.reshape(-1)
-        fdof = (cand.floor_nodes[:, None] * 3 + np.arange(3)).reshape(-1, 3)
-        frows = np.repeat(fdof, 3, axis=1).ravel()
-        fcols = np.tile(fdof, (1, 3)).ravel()
-        rows = np.concatenate([rows, frows])
-        cols = np.concatenate([cols, fcols])
-        vals = np.concatenate([vals, fl_h.reshape(-1)])
-        keep = (rows < n3) & (cols < n3) & (vals != 0)
-        return rows[keep], cols[keep], vals[keep]
 
     # ------------------------------------------------------------------ step bounds
     def step_bound(self, x: FloatArray, dx: FloatArray, close_fraction: float = 0.9) -> float:

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from rotomorph._typing import FloatArray, IntArray
-from rotomorph.contact.potential import Contact, ContactPotential
+from rotomorph.contact.potential import Contact, ContactPotential, HessianBlocks
 from rotomorph.design.network import Network
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.sparse_cholesky import Symbolic, analyse
@@ -55,8 +56,12 @@ class HessianPattern:
         self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
         self._sym: Symbolic | None = None
 
-    def add(self, base: sp.csc_matrix, contact: sp.csc_matrix) -> SparseMatrix:
-        """``base + contact`` (both ``n x n``) on the grown pattern."""
+    def add(
+        self, base: sp.csc_matrix, contact: HessianBlocks, coord_reduced: IntArray
+    ) -> SparseMatrix | None:
+        """``base + contact`` (``n x n``) on the grown pattern; ``coord_reduced`` maps a node
+        coordinate ``3 i + k`` to its free index (-1: fixed). None when the contact blocks have
+        no non-zero entry on free coordinates."""
         n = base.shape[0]
         if self._n != n:
             self._reset(n)
@@ -71,21 +76,19 @@ class HessianPattern:
             or not np.array_equal(known[1], base.indices)
         ):
             self._grow(base, np.zeros(0, dtype=np.int64), n)
-        c = contact.tocoo()
-        ckeys = c.col.astype(np.int64) * n + c.row
-        keys = self._keys
-        pos = np.minimum(np.searchsorted(keys, ckeys), len(keys) - 1)
-        if not np.array_equal(keys[pos], ckeys):
-            self._grow(base, ckeys, n)
-            keys = self._keys
-            pos = np.searchsorted(keys, ckeys)
-        data = np.zeros(len(keys))
-        data[self._base_pos] = base.data
-        if contact.format == "csc" and contact.has_canonical_format:
-            data[pos] += c.data  # one entry per position: the same sums as np.add.at, faster
-        else:
-            np.add.at(data, pos, c.data)
-        assert self._union is not None and self._sym is not None
+        assert self._union is not None
+        blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
+        cdata = np.zeros(len(self._keys))
+        count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata)
+        if count < 0:  # a coupling the pattern does not hold yet
+            self._grow(base, _block_keys(coord_reduced, n, contact), n)
+            cdata = np.zeros(len(self._keys))
+            count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata)
+        if count == 0:
+            return None
+        data = cdata
+        data[self._base_pos] += base.data
+        assert self._sym is not None
         indices, indptr = self._union
         return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)
 
@@ -158,25 +161,21 @@ class ContactTerm:
     # ------------------------------------------------------------------ energy
     def evaluate(
         self, pos: FloatArray, need_grad: bool, need_hess: int
-    ) -> tuple[float, FloatArray | None, sp.csc_matrix | None]:
-        """Energy, gradient on node coordinates ``(3N,)`` and Hessian on the free DOFs."""
-        e, g, trip = self.potential.evaluate(pos, need_grad, need_hess)
+    ) -> tuple[float, FloatArray | None, HessianBlocks | None]:
+        """Energy, gradient on node coordinates ``(3N,)`` and the Hessian's local blocks."""
+        e, g, blocks = self.potential.evaluate_blocks(pos, need_grad, need_hess)
         if not np.isfinite(e):
             return np.inf, None, None
-        hess = None
-        if trip is not None and len(trip[2]):
-            r = self._coord_reduced[trip[0]]
-            c = self._coord_reduced[trip[1]]
-            ok = (r >= 0) & (c >= 0)
-            if ok.any():
-                n = self._nfree
-                hess = sp.csc_matrix((trip[2][ok], (r[ok], c[ok])), shape=(n, n))
-        return e, (None if g is None else g.ravel()), hess
+        return e, (None if g is None else g.ravel()), blocks
 
-    def add_to(self, rod: BandedMatrix | SparseMatrix, contact: sp.csc_matrix) -> SparseMatrix:
-        """The rod Hessian plus the contact Hessian on the grown :class:`HessianPattern`."""
+    def add_to(
+        self, rod: BandedMatrix | SparseMatrix, contact: HessianBlocks
+    ) -> BandedMatrix | SparseMatrix:
+        """The rod Hessian plus the contact Hessian on the grown :class:`HessianPattern` (the
+        rod Hessian itself when no contact entry falls on free coordinates)."""
         base = banded_to_csc(rod) if isinstance(rod, BandedMatrix) else rod.csc
-        return self.pattern.add(base, contact)
+        total = self.pattern.add(base, contact, self._coord_reduced)
+        return rod if total is None else total
 
     @property
     def analyses(self) -> int:
@@ -232,3 +231,78 @@ def tangent_rigid_modes(
     modes[2][coord] = np.cross(n, r)
     modes[2][theta_dof] = tangents @ n
     return modes
+
+
+@njit(cache=True)
+def _find(indices, lo, hi, row, hint):  # pragma: no cover - compiled
+    """Position of ``row`` in the sorted ``indices[lo:hi]`` (-1: absent); ``hint + 1`` is
+    tried first (the next coordinate of the same node)."""
+    if lo <= hint + 1 < hi and indices[hint + 1] == row:
+        return hint + 1
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if indices[mid] < row:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo if lo < indices.shape[0] and indices[lo] == row else -1
+
+
+@njit(cache=True)
+def _scatter_blocks(
+    indptr, indices, coord_reduced, n_nodes, quads, pair, nodes, node, out
+):  # pragma: no cover - compiled
+    """Add the non-zero free entries of the contact blocks into ``out`` (the data array of the
+    CSC pattern ``indptr``, ``indices``); their number, or -1 when one is not in the pattern."""
+    count = 0
+    for p in range(quads.shape[0]):
+        for a in range(4):
+            na = quads[p, a]
+            if na >= n_nodes:
+                continue  # an obstacle point
+            for b in range(4):
+                nb = quads[p, b]
+                if nb >= n_nodes:
+                    continue
+                for m in range(3):
+                    c = coord_reduced[3 * nb + m]
+                    if c < 0:
+                        continue
+                    pos = -2
+                    for k in range(3):
+                        r = coord_reduced[3 * na + k]
+                        v = pair[p, 3 * a + k, 3 * b + m]
+                        if r < 0 or v == 0.0:
+                            continue
+                        pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                        if pos < 0:
+                            return -1
+                        out[pos] += v
+                        count += 1
+    for q in range(nodes.shape[0]):
+        i = nodes[q]
+        for m in range(3):
+            c = coord_reduced[3 * i + m]
+            if c < 0:
+                continue
+            pos = -2
+            for k in range(3):
+                r = coord_reduced[3 * i + k]
+                v = node[q, k, m]
+                if r < 0 or v == 0.0:
+                    continue
+                pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                if pos < 0:
+                    return -1
+                out[pos] += v
+                count += 1
+    return count
+
+
+def _block_keys(coord_reduced: IntArray, n: int, blocks: HessianBlocks) -> IntArray:
+    """Keys ``column * n + row`` of the non-zero entries of ``blocks`` on free coordinates."""
+    rows, cols, _ = blocks.triplets()
+    r = coord_reduced[rows]
+    c = coord_reduced[cols]
+    ok = (r >= 0) & (c >= 0)
+    return np.unique(c[ok].astype(np.int64) * n + r[ok])

@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.contact.obstacles import Floor
-from rotomorph.contact.potential import Contact, InfeasibleContactError
+from rotomorph.contact.potential import Contact, HessianBlocks, InfeasibleContactError
 from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.assembly import (
     evaluate_network,
@@ -123,7 +123,7 @@ class RodObjective:
         self._setup_matrix(topo)
         self._fixed_mask = fixed
         self._contact: ContactTerm | None = None
-        self._contact_hess = None
+        self._contact_hess: HessianBlocks | None = None
         # with friction the floor holds a free body in every direction wherever it touches, and
         # spheres and cylinders hold it in directions that depend on where it touches them: no
         # rigid motion is projected out (one that stays free has zero energy and is handled by
