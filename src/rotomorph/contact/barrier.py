@@ -84,6 +84,29 @@ def cross_norm2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - co
     return A * E - B * B
 
 
+#: relative margin by which the cheap lower bound must exceed the activation reach for a pair to
+#: be skipped without its distance (far above the bound's round-off)
+BOUND_MARGIN = 1e-9
+
+
+@njit(cache=True)
+def _distance_bound(x, i0, i1, j0, j1):  # pragma: no cover - compiled
+    """Lower bound on the distance of segments ``x[i0] x[i1]`` and ``x[j0] x[j1]``: the distance
+    of their midpoints less their half lengths (every point of a segment lies within half its
+    length of its midpoint)."""
+    c2 = 0.0
+    a2 = 0.0
+    b2 = 0.0
+    for k in range(3):
+        c = 0.5 * (x[i0, k] + x[i1, k] - x[j0, k] - x[j1, k])
+        a = x[i1, k] - x[i0, k]
+        b = x[j1, k] - x[j0, k]
+        c2 += c * c
+        a2 += a * a
+        b2 += b * b
+    return np.sqrt(c2) - 0.5 * (np.sqrt(a2) + np.sqrt(b2))
+
+
 @njit(cache=True)
 def pair_barrier(
     x, pairs, dmin, weight, mollify, dhat, kappa, need_grad, need_hess, grad, hloc, dist
@@ -98,8 +121,9 @@ def pair_barrier(
     jump along the overlap); the mollifier fades the edge–edge term out there, and node–segment
     pairs (smooth) carry side-by-side contact. Adds gradients to ``grad`` (M, 3); writes local
     Hessians ``hloc`` (P, 12, 12) when ``need_hess`` is 1 (exact) or 2 (projected to positive
-    semidefinite); writes each pair's centre-line distance to ``dist`` (P,). Returns inf when
-    any pair touches.
+    semidefinite); writes each pair's centre-line distance to ``dist`` (P,) (for a pair
+    clearly beyond ``dmin + dhat``: a lower bound on it, also beyond). Returns inf when any
+    pair touches.
     """
     energy = 0.0
     no, yes = np.bool_(False), np.bool_(True)  # not literals: one compiled segment_distance2
@@ -112,9 +136,14 @@ def pair_barrier(
     off = np.empty(12)
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
+        reach = dmin[p] + dhat
+        bound = _distance_bound(x, i0, i1, j0, j1)
+        if bound > reach * (1.0 + BOUND_MARGIN):
+            dist[p] = bound  # clearly out of reach: the distance itself is not needed
+            continue
         D = pair_distance2(x, i0, i1, j0, j1)
         dist[p] = np.sqrt(D)
-        if D >= (dmin[p] + dhat) * (dmin[p] + dhat):
+        if D >= reach * reach:
             continue  # inactive: zero energy, its hloc block is left unwritten
         D = segment_distance2(x[i0], x[i1], x[j0], x[j1], no, g, h)
         zhat = (2.0 * dmin[p] + dhat) * dhat
