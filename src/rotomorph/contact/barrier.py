@@ -21,7 +21,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rotomorph.contact.distance import pair_distance2, segment_distance2
+from rotomorph.contact.distance import (
+    BOUND_MARGIN,
+    distance_bound,
+    pair_distance2,
+    segment_distance2,
+)
 from rotomorph.contact.psd import psd_project
 
 
@@ -84,29 +89,6 @@ def cross_norm2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - co
     return A * E - B * B
 
 
-#: relative margin by which the cheap lower bound must exceed the activation reach for a pair to
-#: be skipped without its distance (far above the bound's round-off)
-BOUND_MARGIN = 1e-9
-
-
-@njit(cache=True)
-def _distance_bound(x, i0, i1, j0, j1):  # pragma: no cover - compiled
-    """Lower bound on the distance of segments ``x[i0] x[i1]`` and ``x[j0] x[j1]``: the distance
-    of their midpoints less their half lengths (every point of a segment lies within half its
-    length of its midpoint)."""
-    c2 = 0.0
-    a2 = 0.0
-    b2 = 0.0
-    for k in range(3):
-        c = 0.5 * (x[i0, k] + x[i1, k] - x[j0, k] - x[j1, k])
-        a = x[i1, k] - x[i0, k]
-        b = x[j1, k] - x[j0, k]
-        c2 += c * c
-        a2 += a * a
-        b2 += b * b
-    return np.sqrt(c2) - 0.5 * (np.sqrt(a2) + np.sqrt(b2))
-
-
 @njit(cache=True)
 def pair_barrier(
     x, pairs, dmin, weight, mollify, dhat, kappa, need_grad, need_hess, grad, hloc, dist
@@ -137,7 +119,7 @@ def pair_barrier(
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
         reach = dmin[p] + dhat
-        bound = _distance_bound(x, i0, i1, j0, j1)
+        bound = distance_bound(x, i0, i1, j0, j1)
         if bound > reach * (1.0 + BOUND_MARGIN):
             dist[p] = bound  # clearly out of reach: the distance itself is not needed
             continue

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rotomorph.contact.distance import moving_distance2
+from rotomorph.contact.distance import BOUND_MARGIN, distance_bound, moving_distance2
 
 ADVANCE = 0.9  # fraction of the provably safe advance taken per sub-step
 
@@ -59,6 +59,11 @@ def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragm
             else:
                 lq = max(lq, ln)
         rate[p] = lp + lq
+        bound = distance_bound(x0, i0, i1, j0, j1) - dmin[p]
+        if bound > 0.0 and ADVANCE * bound >= (1.0 + BOUND_MARGIN) * rate[p]:
+            gap0[p] = bound  # cannot close even its first advance within the whole step
+            first[p] = np.inf
+            continue
         gap0[p] = _distance(x0, dx, 0.0, i0, i1, j0, j1) - dmin[p]
         if gap0[p] <= 0.0:
             return 0.0

@@ -217,3 +217,26 @@ def pair_distances(x, pairs):  # pragma: no cover - compiled
     for p in range(pairs.shape[0]):
         out[p] = np.sqrt(pair_distance2(x, pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]))
     return out
+
+
+#: relative margin by which :func:`distance_bound` must clear a threshold before a caller skips
+#: the exact distance on it (far above the bound's round-off)
+BOUND_MARGIN = 1e-9
+
+
+@njit(cache=True)
+def distance_bound(x, i0, i1, j0, j1):  # pragma: no cover - compiled
+    """Lower bound on the distance of segments ``x[i0] x[i1]`` and ``x[j0] x[j1]``: the distance
+    of their midpoints less their half lengths (every point of a segment lies within half its
+    length of its midpoint)."""
+    c2 = 0.0
+    a2 = 0.0
+    b2 = 0.0
+    for k in range(3):
+        c = 0.5 * (x[i0, k] + x[i1, k] - x[j0, k] - x[j1, k])
+        a = x[i1, k] - x[i0, k]
+        b = x[j1, k] - x[j0, k]
+        c2 += c * c
+        a2 += a * a
+        b2 += b * b
+    return np.sqrt(c2) - 0.5 * (np.sqrt(a2) + np.sqrt(b2))
