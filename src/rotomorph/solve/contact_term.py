@@ -79,11 +79,14 @@ class HessianPattern:
         assert self._union is not None
         blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
         cdata = np.zeros(len(self._keys))
-        count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata)
-        if count < 0:  # a coupling the pattern does not hold yet
-            self._grow(base, _block_keys(coord_reduced, n, contact), n)
+        no_keys = np.zeros(0, dtype=np.int64)
+        count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, no_keys)
+        if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
+            keys = np.empty(144 * len(contact.quads) + 9 * len(contact.nodes), dtype=np.int64)
+            found = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, keys)
+            self._grow(base, np.unique(keys[:found]), n)
             cdata = np.zeros(len(self._keys))
-            count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata)
+            count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, no_keys)
         if count == 0:
             return None
         data = cdata
@@ -250,18 +253,27 @@ def _find(indices, lo, hi, row, hint):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _scatter_blocks(
-    indptr, indices, coord_reduced, n_nodes, quads, pair, nodes, node, out
+    indptr, indices, coord_reduced, n_nodes, quads, pair, nodes, node, out, keys
 ):  # pragma: no cover - compiled
     """Add the non-zero free entries of the contact blocks into ``out`` (the data array of the
-    CSC pattern ``indptr``, ``indices``); their number, or -1 when one is not in the pattern."""
+    CSC pattern ``indptr``, ``indices``); their number, or -1 when one is not in the pattern.
+
+    With ``keys`` non-empty (room for every entry) the entries' keys ``column * n + row`` are
+    written there instead (``n = len(indptr) - 1``) and nothing is looked up.
+    """
+    collect = keys.shape[0] > 0
+    n = indptr.shape[0] - 1
     count = 0
-    for p in range(quads.shape[0]):
-        for a in range(4):
-            na = quads[p, a]
+    for p in range(quads.shape[0] + nodes.shape[0]):
+        block = p < quads.shape[0]
+        q = p - quads.shape[0]
+        width = 4 if block else 1
+        for a in range(width):
+            na = quads[p, a] if block else nodes[q]
             if na >= n_nodes:
                 continue  # an obstacle point
-            for b in range(4):
-                nb = quads[p, b]
+            for b in range(width):
+                nb = quads[p, b] if block else nodes[q]
                 if nb >= n_nodes:
                     continue
                 for m in range(3):
@@ -271,38 +283,15 @@ def _scatter_blocks(
                     pos = -2
                     for k in range(3):
                         r = coord_reduced[3 * na + k]
-                        v = pair[p, 3 * a + k, 3 * b + m]
+                        v = pair[p, 3 * a + k, 3 * b + m] if block else node[q, k, m]
                         if r < 0 or v == 0.0:
                             continue
-                        pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
-                        if pos < 0:
-                            return -1
-                        out[pos] += v
+                        if collect:
+                            keys[count] = c * n + r
+                        else:
+                            pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                            if pos < 0:
+                                return -1
+                            out[pos] += v
                         count += 1
-    for q in range(nodes.shape[0]):
-        i = nodes[q]
-        for m in range(3):
-            c = coord_reduced[3 * i + m]
-            if c < 0:
-                continue
-            pos = -2
-            for k in range(3):
-                r = coord_reduced[3 * i + k]
-                v = node[q, k, m]
-                if r < 0 or v == 0.0:
-                    continue
-                pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
-                if pos < 0:
-                    return -1
-                out[pos] += v
-                count += 1
     return count
-
-
-def _block_keys(coord_reduced: IntArray, n: int, blocks: HessianBlocks) -> IntArray:
-    """Keys ``column * n + row`` of the non-zero entries of ``blocks`` on free coordinates."""
-    rows, cols, _ = blocks.triplets()
-    r = coord_reduced[rows]
-    c = coord_reduced[cols]
-    ok = (r >= 0) & (c >= 0)
-    return np.unique(c[ok].astype(np.int64) * n + r[ok])
