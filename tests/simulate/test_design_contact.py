@@ -48,6 +48,7 @@ def test_self_contact_keeps_the_ring_apart():
         "gravity": False,
         "friction": 0.0,
         "branch": "lowest",
+        "path_check": 1,
     }
 
 
@@ -90,3 +91,19 @@ def test_the_floor_branch_reaches_the_lattice_ramp_and_a_bad_one_is_refused():
         assert lattice_surroundings(design.contact, lattice, 175.0)["branch"] == branch
     with pytest.raises(InvalidDesignError, match="branch"):
         parse_design({**RING, "contact": {"floor": True, "branch": "global"}})
+
+
+def test_the_path_check_reaches_the_lattice_ramp_and_is_refused_for_filaments():
+    from rotomorph.design.lattices import sinusoidal_lattice
+    from rotomorph.simulate.surroundings import lattice_surroundings
+
+    lattice = sinusoidal_lattice(n=2, ghost_nodes=2)
+    design = parse_design(
+        {"schema_version": 1, "lattice": {"n": 2}, "contact": {"floor": True, "path_check": 2}}
+    )
+    assert lattice_surroundings(design.contact, lattice, 175.0)["path_check"] == 2
+    with pytest.raises(InvalidDesignError, match="applies to lattices"):
+        parse_design({**RING, "contact": {"self_contact": True, "path_check": 2}})
+    for bad in (0, 9, 1.5):
+        with pytest.raises(InvalidDesignError, match="path_check"):
+            parse_design({"schema_version": 1, "lattice": {"n": 2}, "contact": {"path_check": bad}})

@@ -535,6 +535,13 @@ class ContactModel(_Model):
         description="lattices resting on the floor under their weight: 'lowest' takes a lifted "
         "equilibrium where one is lower in energy, 'continuous' follows the resting state",
     )
+    path_check: int = Field(
+        1,
+        ge=1,
+        le=8,
+        description="lattices: also ramp with every step split into this many sub-steps and "
+        "keep the end state lower in total energy where the two differ (1: no check)",
+    )
 
     @model_validator(mode="after")
     def _weight_needs_support(self) -> ContactModel:
@@ -579,6 +586,10 @@ class Design(_Model):
         if self.filaments and self.lattice is not None:
             raise ValueError(
                 "a design holds [[filaments]] or one [lattice], not both; split it into two files"
+            )
+        if self.filaments and self.contact is not None and self.contact.path_check != 1:
+            raise ValueError(
+                "contact.path_check applies to lattices; remove it from a filament design"
             )
         refusal = design_size(self).refusal()
         if refusal:

@@ -45,6 +45,7 @@ from rotomorph.lattice.actuation import (
     get_actuation,
 )
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
+from rotomorph.lattice.paths import PathCheck, check_factor, choose_end, sub_stepped
 from rotomorph.rod.assembly import reference_twist
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
@@ -234,13 +235,18 @@ class HeatingResult:
         With ``branch="lowest"`` on a floor under weight: total energy of the best lifted
         equilibrium found minus that of the resting one at each step where the lattice rested
         on the floor and its unsupported lowest mode was unstable (N mm; negative: the lifted
-        branch was taken); NaN where no lifted equilibrium was probed or found.
+        branch was taken); NaN where no lifted equilibrium was probed or found. A step's row
+        holds the lowest gap probed within it (at the step itself or at a halved or path-check
+        sub-step on the way to it).
     lift_off_bracket, buckling_bracket
         With ``lift_off_tolerance``: ramp-parameter intervals ``(lo, hi)`` holding the
         lift-off (at ``lo`` the lattice rests and no lower lifted state was found, at ``hi``
         one was) and the buckling of the weightless flat lattice (its lowest mode stable at
         ``lo``, unstable at ``hi``); None where not refined or not reached. Their difference
         is the delay the weight causes.
+    path_check
+        With ``path_check > 1``: the :class:`~rotomorph.lattice.paths.PathCheck` (both ramps'
+        final energies and which was kept); None without.
     """
 
     parameter: FloatArray
@@ -268,6 +274,7 @@ class HeatingResult:
     lift_energy_gap: FloatArray | None = None
     lift_off_bracket: tuple[float, float] | None = None
     buckling_bracket: tuple[float, float] | None = None
+    path_check: PathCheck | None = None
 
     @property
     def final_area_ratio(self) -> float:
@@ -381,6 +388,7 @@ def heat_lattice(
     friction: float = 0.0,
     branch: Literal["lowest", "continuous"] = "lowest",
     lift_off_tolerance: float | None = None,
+    path_check: int = 1,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -445,6 +453,13 @@ def heat_lattice(
         unstable), so the weight's delay of lift-off is resolved below the step size
         (``HeatingResult.lift_off_bracket``, ``buckling_bracket``; the extra solves are not
         in ``iterations``). Default None: not refined.
+    path_check
+        ``k > 1``: ramp the lattice a second time with every step split into ``k`` sub-steps
+        and, where the two ramps end in different stable states (a multistable lattice whose
+        end state depends on the path), keep the one lower in total energy
+        (:mod:`rotomorph.lattice.paths`; ``HeatingResult.path_check`` records it). A kept
+        sub-stepped ramp is sampled at the requested steps (its sub-steps' iterations count
+        toward them). Default 1: no check.
 
     Returns
     -------
@@ -505,6 +520,7 @@ def heat_lattice(
         and not settings.friction
         else None
     )
+    factor = check_factor(path_check)
     values = np.linspace(act.start, act.end, int(steps) + 1)
 
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
@@ -538,6 +554,35 @@ def heat_lattice(
         return res
 
     path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
+    finals = path.results
+    checked: PathCheck | None = None
+    if factor > 1:
+        phase_log.info("path check: the ramp again with %d sub-steps per step", factor)
+        # the solve closure appends to these: keep the first ramp's, collect the second's
+        first_events, first_probes = list(events), dict(probes)
+        events.clear()
+        probes.clear()
+        try:
+            fine = continuation(
+                solve,
+                sub_stepped(values, factor)[1:],
+                initial,
+                start=values[0],
+                max_halvings=max_halvings,
+            )
+            other, ok = fine.final.energy, _stable_flag(fine.final) is True
+        except ConvergenceError:
+            fine, other, ok = None, np.nan, False
+        checked = choose_end(path.final.energy, other, ok, factor)
+        if checked.kept == "sub-steps":
+            assert fine is not None
+            finals = fine.results[factor - 1 :: factor]
+            path = fine
+        else:
+            events[:] = first_events
+            probes.clear()
+            probes.update(first_probes)
+    per_step = factor if len(path.steps) > len(finals) else 1  # sub-steps per kept row
     brackets: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)
     if probe_floor is not None and lift_off_tolerance is not None:
         assert settings is not None  # a floor implies contact settings
@@ -551,23 +596,24 @@ def heat_lattice(
             probe_floor,
             lattice,
             values,
-            [initial] + [r.state for r in path.results],
+            [initial] + [r.state for r in finals],
             float(lift_off_tolerance),
         )
     phase_log.info("analysis: areas, surface fits, edge ratios, clearances")
     ref = lattice.network.nodes
     loop = lattice_boundary_loop(lattice.edge_chains, lattice.n)
-    positions = np.stack([ref] + [r.positions for r in path.results])
-    energy = np.array([0.0] + [r.energy for r in path.results])
-    residual = np.array([0.0] + [r.residual for r in path.results])
+    positions = np.stack([ref] + [r.positions for r in finals])
+    energy = np.array([0.0] + [r.energy for r in finals])
+    residual = np.array([0.0] + [r.residual for r in finals])
     iterations = np.zeros(len(values), dtype=np.int64)
     k = 1
     for p, its, ok in events:  # sub-steps and failed attempts count toward their step
         iterations[k] += its
-        if ok and k < len(values) and p == path.steps[k - 1].parameter:
+        if ok and k < len(values) and p == values[k]:
             k += 1
-    halvings = np.array([0] + [s.halvings for s in path.steps], dtype=np.int64)
-    wall = np.array([0.0] + [s.wall_time for s in path.steps])
+    groups = [path.steps[i : i + per_step] for i in range(0, len(path.steps), per_step)]
+    halvings = np.array([0] + [max(s.halvings for s in g) for g in groups], dtype=np.int64)
+    wall = np.array([0.0] + [sum(s.wall_time for s in g) for g in groups])
     fused = fused_pairs(ref, lattice.network.edges, 2.0 * lattice.radius)
     rows = [_measure(lattice, p, ref, loop, fused) for p in positions]
     ratios = np.stack([r[3] for r in rows])
@@ -597,18 +643,31 @@ def heat_lattice(
         lattice=lattice,
         model=lm,
         actuation=act.name,
-        states=(lm.model.reference_state(), *(r.state for r in path.results)),
-        stable=(True, *(_stable_flag(r) for r in path.results)),
-        lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues],
+        states=(lm.model.reference_state(), *(r.state for r in finals)),
+        stable=(True, *(_stable_flag(r) for r in finals)),
+        lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues[per_step - 1 :: per_step]],
         contact=settings,
         contacts_active=active,
         floor_lift=lift,
-        lift_energy_gap=None
-        if probe_floor is None
-        else np.array([np.nan] + [probes.get(float(v), np.nan) for v in values[1:]]),
+        lift_energy_gap=None if probe_floor is None else _gaps_per_step(probes, values),
         lift_off_bracket=brackets[0],
         buckling_bracket=brackets[1],
+        path_check=checked,
     )
+
+
+def _gaps_per_step(probes: dict[float, float], values: FloatArray) -> FloatArray:
+    """Row ``k`` (``k >= 1``): the lowest lift-probe gap at parameters in
+    ``(values[k-1], values[k]]`` (ramps may run either way); NaN where none was probed."""
+    out = np.full(len(values), np.nan)
+    for p, gap in probes.items():
+        for k in range(1, len(values)):
+            lo, hi = sorted((values[k - 1], values[k]))
+            inside = lo < p <= hi if values[k] >= values[k - 1] else lo <= p < hi
+            if inside:
+                out[k] = gap if np.isnan(out[k]) else min(out[k], gap)
+                break
+    return out
 
 
 #: Height of the lifted start of :func:`_lift_probe`, in lattice spacings l (0.5 mm for the

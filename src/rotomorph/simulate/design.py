@@ -387,6 +387,7 @@ def _simulate_lattice(
         "contact": surroundings_record(design.contact, hot),
         "assumptions": lattice_assumptions(lattice),
         "lattice_wall_time_s": float(np.sum(res.wall_time)),
+        "path_check": None if res.path_check is None else res.path_check.note,
     }
     net = lattice.network
     return DesignSimulation(

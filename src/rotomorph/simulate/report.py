@@ -20,7 +20,7 @@ report fails loudly (:class:`~rotomorph.errors.ConvergenceError`, after writing 
 a number is not converged to 1 % unless ``allow_unconverged``. Every contact-resolved lattice
 ramp is also run in :data:`PATH_CHECK_FACTOR` times the steps; where the two end in different
 stable states (a multistable lattice), the one lower in total energy is counted
-(:func:`lower_energy_end`) and the row's note gives both.
+(:mod:`rotomorph.lattice.paths`) and the row's note says so.
 
 Sections: Janus curvature vs speed (Fig. 2D), L/L0 vs ω* (Fig. 2F/G), sinusoidal filaments
 (Fig. 3C/D), lattice areas (Fig. 3G), dome and saddle lattices (Fig. 4). A lattice part that
@@ -248,55 +248,16 @@ def _sinusoid_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pat
 LATTICE_GHOSTS = {True: (6, 12), False: (10, 20)}
 #: Heating steps of the full lattice ramps.
 LATTICE_STEPS = 8
-#: Every contact-resolved lattice ramp is also run with this many times the steps: a lattice
-#: with several stable states can end in a different one when the path changes (path
-#: dependence), and then the end state lower in total energy is counted.
+#: Every contact-resolved lattice ramp is also run with each step split into this many
+#: sub-steps: a lattice with several stable states can end in a different one when the path
+#: changes (path dependence), and then the end state lower in total energy is counted
+#: (``heat_lattice(..., path_check=...)``).
 PATH_CHECK_FACTOR = 2
-#: Relative difference of total energy below which two ramps ended in the same state.
-SAME_STATE_RTOL = 1e-6
 #: Width (°C) to which the dome's and saddle's lift-off and weightless buckling are bisected.
 LIFT_OFF_TOLERANCE = 0.5
 #: Heating steps of the perturbed ramps that propagate the calibration's uncertainty (the
 #: secants compare ramps of the same steps, without contact: no lift-off, no jamming).
 SD_STEPS = 4
-
-
-def lower_energy_end(first: Any, second: Any) -> tuple[int, str]:
-    """Which of two ramps of one lattice to count, and a note saying why.
-
-    ``first`` and ``second`` are :class:`~rotomorph.lattice.heating.HeatingResult` objects of
-    the same lattice, model, floor and weight, ramped in different numbers of steps (``None``
-    for a failed ramp). Both end at the same temperature, so their total energies (elastic +
-    weight + barrier) compare. Returns ``(0 or 1, note)``: the first unless the second ends
-    in a different state that is certified stable, free of interpenetration and lower in
-    total energy (the lowest-energy choice of the floor's lift probe, applied to the path).
-    """
-
-    def describe(res: Any) -> str:
-        return (
-            f"{len(res.parameter) - 1} steps: total energy {float(res.energy[-1]):.6g} N mm, "
-            f"sign {int(res.gaussian_sign[-1]):+d}, A/A0 {float(res.final_area_ratio):.4g}"
-        )
-
-    if second is None:
-        return 0, "path check: the ramp with more steps failed"
-    if first is None:
-        return 1, "path check: only the ramp with more steps converged"
-    e1, e2 = float(first.energy[-1]), float(second.energy[-1])
-    if abs(e2 - e1) <= SAME_STATE_RTOL * max(abs(e1), abs(e2), 1e-300):
-        return 0, (
-            f"path check: the ramp in {len(second.parameter) - 1} steps ends in the same state"
-        )
-    admissible = bool(second.stable[-1]) and float(np.min(second.min_clearance)) >= 0.999
-    pick = 1 if admissible and e2 < e1 else 0
-    return pick, (
-        "path check: the ramps end in different stable states ("
-        + describe(first)
-        + "; "
-        + describe(second)
-        + "); the lattice is multistable and the one lower in total energy is counted ("
-        + f"{len((first, second)[pick].parameter) - 1} steps)"
-    )
 
 
 def _heat(
@@ -308,6 +269,7 @@ def _heat(
     contact: bool = False,
     branch: str = "lowest",
     lift_off_tolerance: float | None = None,
+    path_check: int = 1,
 ) -> tuple[Any, Any, str]:
     """(lattice, HeatingResult or None, reason): heated through the materials chain;
     ``contact``: with self-contact, resting on the bath floor under its buoyant weight;
@@ -328,7 +290,7 @@ def _heat(
         actuation = mode(filament_model=model)
         key = repr(
             (pattern, n, ghosts, steps, actuation)
-            + (("bath floor", branch, lift_off_tolerance) if contact else ())
+            + (("bath floor", branch, lift_off_tolerance, path_check) if contact else ())
         )
         extra: dict[str, Any] = {}
         if contact:
@@ -339,6 +301,7 @@ def _heat(
                 "gravity": lattice_gravity(lattice),
                 "branch": branch,
                 "lift_off_tolerance": lift_off_tolerance,
+                "path_check": path_check,
             }
         result = disk_cached(
             "heat_lattice",
@@ -396,19 +359,24 @@ def _lattice_section(
 
     def on_floor(pattern: str, ghosts: int) -> tuple[Any, Any, str]:
         lift_tol = LIFT_OFF_TOLERANCE if pattern in ("dome", "saddle") else None
-        first = _heat(pattern, quick, steps, model, ghosts, True, lift_off_tolerance=lift_tol)
-        more = PATH_CHECK_FACTOR * steps
-        check = _heat(pattern, quick, more, model, ghosts, True)
-        pick, paths_checked[pattern, ghosts] = lower_energy_end(first[1], check[1])
-        if pick == 0:
-            return first
-        # the counted ramp also bisects its lift-off (the same ramp, cached separately)
-        return _heat(pattern, quick, more, model, ghosts, True, lift_off_tolerance=lift_tol)
+        out = _heat(
+            pattern,
+            quick,
+            steps,
+            model,
+            ghosts,
+            True,
+            lift_off_tolerance=lift_tol,
+            path_check=PATH_CHECK_FACTOR,
+        )
+        if out[1] is not None and out[1].path_check is not None:
+            paths_checked[pattern, ghosts] = out[1].path_check.note
+        return out
 
     def path_note(pattern: str) -> str:
         return "; ".join(
             f"{g} ghost nodes per edge, {paths_checked[pattern, g]}"
-            for g in (coarse_g, fine_g)
+            for g in (coarse_g, fine_g, 2 * fine_g)
             if (pattern, g) in paths_checked
         )
 

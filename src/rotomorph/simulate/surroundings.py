@@ -72,7 +72,8 @@ def filament_surroundings(
 
 def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict[str, Any]:
     """Keyword arguments of :func:`rotomorph.lattice.heating.heat_lattice` for ``[contact]``
-    (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``, ``branch``."""
+    (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``, ``branch``,
+    ``path_check``."""
     if contact is None:
         return {}
     from rotomorph.lattice.heating import lattice_gravity  # lattice-only
@@ -82,6 +83,7 @@ def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict
         "floor": bool(contact.floor),
         "friction": float(contact.friction),
         "branch": str(contact.branch),
+        "path_check": int(contact.path_check),
     }
     if contact.gravity:
         kwargs["gravity"] = lattice_gravity(
@@ -100,6 +102,7 @@ def surroundings_record(contact: Any, temperature: float) -> dict[str, Any] | No
         "gravity": bool(contact.gravity),
         "friction": float(contact.friction),
         "branch": str(contact.branch),
+        "path_check": int(contact.path_check),
     }
     if contact.gravity:
         fluid = bath_fluids()[contact.bath]
