@@ -650,7 +650,12 @@ def _lattice_section(
                     ms=9,
                     mfc="none",
                     mec="tab:red",
-                    label=f"leaves the floor ({lift:.4g} °C)",
+                    label=f"first ramp step off the floor ({lift:.4g} °C)"
+                    + (
+                        ""
+                        if res.lift_off_bracket is None
+                        else f"; lift-off bisected to {0.5 * sum(res.lift_off_bracket):.1f} °C"
+                    ),
                 )
         ax.set_xlabel("mean edge strain (–)")
         ax.set_ylabel("√|k1 k2| (1/mm)")
