@@ -356,6 +356,30 @@ def lattice_gravity(
     return Gravity(density=density, area=area, fluid_density=fluid_density)
 
 
+def lattice_buoyancy(
+    lattice: Lattice, *, bath: str = "silicone_oil", density: float | None = None
+) -> Callable[[float], Gravity]:
+    """The lattice's buoyant self-weight as a function of the bath temperature (°C).
+
+    Returns ``T ↦`` :func:`lattice_gravity` with the bath's density at ``T``
+    (:func:`rotomorph.materials.bath.bath_density`: silicone oil expands on heating, 0.97 g/cm³
+    at 25 °C and about 0.85 at 175 °C, so a lattice weighs about twice as much in the hot
+    bath). Pass it as ``heat_lattice(..., gravity=...)`` for ramps in temperature. The
+    filament density is the inks' at room temperature (their thermal expansion is not in the
+    weight).
+    """
+    from rotomorph.materials.bath import bath_density
+
+    bath_density(bath)  # an unknown fluid fails here, not inside the ramp
+
+    def at(temperature: float) -> Gravity:
+        return lattice_gravity(
+            lattice, fluid_density=bath_density(bath, temperature), density=density
+        )
+
+    return at
+
+
 def _measure(
     lattice: Lattice, pos: FloatArray, ref: FloatArray, loop: IntArray, fused: IntArray
 ) -> tuple:
@@ -378,7 +402,7 @@ def heat_lattice(
     steps: int = 16,
     stiffness: Stiffness | None = None,
     supports: SupportsName = "free",
-    gravity: Gravity | None = None,
+    gravity: Gravity | Callable[[float], Gravity] | None = None,
     seed: int = 0,
     perturbation: float = 1e-3,
     options: NewtonOptions | None = None,
@@ -411,8 +435,10 @@ def heat_lattice(
         touching a perimeter branch node clamped: position and frame fixed) or
         ``"pinned-centre"`` (the central branch node pinned, e.g. to carry gravity).
     gravity
-        Optional self-weight (:func:`lattice_gravity`); a free lattice needs a ``floor`` to
-        rest on, otherwise supports other than ``"free"``.
+        Optional self-weight: a :class:`~rotomorph.solve.loads.Gravity`
+        (:func:`lattice_gravity`) or a function of the ramp parameter returning one
+        (:func:`lattice_buoyancy`: the bath's density at each ramp temperature). A free
+        lattice needs a ``floor`` to rest on, otherwise supports other than ``"free"``.
     seed
         Seed of the symmetry-breaking noise.
     perturbation
@@ -490,7 +516,10 @@ def heat_lattice(
         stiffness,
     )
     lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
-    loads = Loads(gravity=gravity)
+
+    def loads_at(p: float) -> Loads:
+        return Loads(gravity=gravity(p) if callable(gravity) else gravity)
+
     phase_log.info("set-up: perturbed flat start")
     dz = symmetry_breaking(lattice, perturbation * lattice.spacing, seed)
     initial = perturbed_state(lm.model, dz)
@@ -533,6 +562,7 @@ def heat_lattice(
         if not events:
             phase_log.info("set-up: Hessian sparsity pattern and ordering; then Newton solves")
         try:
+            loads = loads_at(p)
             res = solve_static(model, sup, loads, initial=state, options=options, contact=settings)
         except ConvergenceError as err:
             events.append((p, int(getattr(err.result, "iterations", 0)), False))
@@ -590,7 +620,7 @@ def heat_lattice(
         brackets = _refine_lift_off(
             lambda p: act.natural(lm, p),
             sup,
-            loads,
+            loads_at,
             settings,
             options,
             probe_floor,
@@ -772,7 +802,7 @@ def _lift_probe(
 def _refine_lift_off(
     natural: Callable[[float], Model],
     supports: Supports,
-    loads: Loads,
+    loads: Callable[[float], Loads],
     settings: Contact,
     options: NewtonOptions,
     floor: Floor,
@@ -801,14 +831,14 @@ def _refine_lift_off(
     def resting(p: float, start: State) -> tuple[Model, StaticResult]:
         model = natural(p)
         return model, solve_static(
-            model, supports, loads, initial=start, options=options, contact=settings
+            model, supports, loads(p), initial=start, options=options, contact=settings
         )
 
     def leaves(p: float, start: State) -> tuple[bool, State]:
         model, res = resting(p, start)
         if lifted(res.state):
             return True, res.state
-        best, _, _ = _lift_probe(model, supports, loads, settings, res, options, floor, lattice)
+        best, _, _ = _lift_probe(model, supports, loads(p), settings, res, options, floor, lattice)
         return best is not None, res.state
 
     def buckled(p: float, start: State) -> tuple[bool, State]:

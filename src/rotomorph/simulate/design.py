@@ -353,7 +353,12 @@ def _simulate_lattice(
         lattice,
         actuation=rule,
         steps=steps,
-        **lattice_surroundings(design.contact, lattice, hot),
+        **lattice_surroundings(
+            design.contact,
+            lattice,
+            hot,
+            ramp_in_temperature=actuation in ("thermal", "program"),
+        ),
     )
     if progress is not None:
         progress(1)

@@ -290,15 +290,19 @@ def _heat(
         actuation = mode(filament_model=model)
         key = repr(
             (pattern, n, ghosts, steps, actuation)
-            + (("bath floor", branch, lift_off_tolerance, path_check) if contact else ())
+            + (
+                ("bath floor", "buoyancy(T)", branch, lift_off_tolerance, path_check)
+                if contact
+                else ()
+            )
         )
         extra: dict[str, Any] = {}
         if contact:
-            from rotomorph.lattice.heating import lattice_gravity
+            from rotomorph.lattice.heating import lattice_buoyancy
 
             extra = {
                 "floor": True,
-                "gravity": lattice_gravity(lattice),
+                "gravity": lattice_buoyancy(lattice),
                 "branch": branch,
                 "lift_off_tolerance": lift_off_tolerance,
                 "path_check": path_check,

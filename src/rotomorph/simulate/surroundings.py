@@ -70,13 +70,17 @@ def filament_surroundings(
     return settings, loads
 
 
-def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict[str, Any]:
+def lattice_surroundings(
+    contact: Any, lattice: Any, temperature: float, *, ramp_in_temperature: bool = False
+) -> dict[str, Any]:
     """Keyword arguments of :func:`rotomorph.lattice.heating.heat_lattice` for ``[contact]``
     (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``, ``branch``,
-    ``path_check``."""
+    ``path_check``. The buoyant weight is that in the bath at ``temperature`` (°C), or, with
+    ``ramp_in_temperature`` (a ramp whose parameter is the temperature), at every ramp
+    temperature (:func:`rotomorph.lattice.heating.lattice_buoyancy`)."""
     if contact is None:
         return {}
-    from rotomorph.lattice.heating import lattice_gravity  # lattice-only
+    from rotomorph.lattice.heating import lattice_buoyancy, lattice_gravity  # lattice-only
 
     kwargs: dict[str, Any] = {
         "contact": Contact(radius=lattice.radius, self_contact=contact.self_contact),
@@ -86,8 +90,10 @@ def lattice_surroundings(contact: Any, lattice: Any, temperature: float) -> dict
         "path_check": int(contact.path_check),
     }
     if contact.gravity:
-        kwargs["gravity"] = lattice_gravity(
-            lattice, fluid_density=bath_density(contact.bath, temperature)
+        kwargs["gravity"] = (
+            lattice_buoyancy(lattice, bath=contact.bath)
+            if ramp_in_temperature
+            else lattice_gravity(lattice, fluid_density=bath_density(contact.bath, temperature))
         )
     return kwargs
 
