@@ -198,7 +198,10 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     coo_col = np.repeat(np.arange(n), np.diff(A.indptr))
     bi_all, bj_all = inv[coo_row], inv[coo_col]
     upper = bi_all <= bj_all
-    order = np.lexsort((bi_all[upper], bj_all[upper]))
+    # by column, then row: one sort of the combined key (np.lexsort's order; a canonical matrix
+    # has no repeated entry, so the keys are distinct and any sort gives that order)
+    kind = "quicksort" if A.has_canonical_format else "stable"
+    order = np.argsort(bj_all[upper] * n + bi_all[upper], kind=kind)
     src = np.flatnonzero(upper)[order].astype(np.int64)
     bi = bi_all[upper][order].astype(np.int64)
     bj = bj_all[upper][order]
