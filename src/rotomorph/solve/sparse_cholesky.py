@@ -200,8 +200,8 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     upper = bi_all <= bj_all
     # by column, then row: one sort of the combined key (np.lexsort's order; a canonical matrix
     # has no repeated entry, so the keys are distinct and any sort gives that order)
-    kind = "quicksort" if A.has_canonical_format else "stable"
-    order = np.argsort(bj_all[upper] * n + bi_all[upper], kind=kind)
+    key = bj_all[upper] * n + bi_all[upper]
+    order = np.argsort(key) if A.has_canonical_format else np.argsort(key, kind="stable")
     src = np.flatnonzero(upper)[order].astype(np.int64)
     bi = bi_all[upper][order].astype(np.int64)
     bj = bj_all[upper][order]
