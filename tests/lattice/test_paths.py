@@ -7,9 +7,16 @@ import pytest
 
 import rotomorph.lattice.heating as heating
 from rotomorph.design.lattices import sinusoidal_lattice
-from rotomorph.errors import InvalidParameterError
+from rotomorph.errors import ConvergenceError, InvalidParameterError
 from rotomorph.lattice import heat_lattice
-from rotomorph.lattice.paths import PathCheck, check_factor, choose_end, sub_stepped
+from rotomorph.lattice.heating import _gaps_per_step, lattice_gravity
+from rotomorph.lattice.paths import (
+    PathCheck,
+    check_factor,
+    choose_end,
+    shape_distance,
+    sub_stepped,
+)
 
 
 def test_sub_stepped_keeps_the_requested_values_exactly():
@@ -20,40 +27,69 @@ def test_sub_stepped_keeps_the_requested_values_exactly():
     np.testing.assert_allclose(fine, np.linspace(25.0, 175.0, 25), rtol=1e-15, atol=1e-12)
 
 
+def test_shape_distance_ignores_rigid_motion():
+    rng = np.random.default_rng(1)
+    a = rng.normal(size=(40, 3))
+    c, s = np.cos(0.7), np.sin(0.7)
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    assert shape_distance(a, a @ rot.T + [3.0, -1.0, 2.0]) < 1e-12
+    b = a.copy()
+    b[5] += [0.0, 0.0, 0.1]
+    assert 0.05 < shape_distance(a, b) < 0.1
+
+
 def test_choose_end():
-    assert choose_end(0.2, 0.2 * (1 + 1e-8), True, 2).kept == "steps"
-    assert choose_end(0.2, 0.2 * (1 + 1e-8), True, 2).same_state
-    lower = choose_end(0.222, 0.214, True, 2)
+    same = choose_end((0.2, 0.1), (True, True), True, 2)
+    assert same.kept == "steps" and same.same_state and "same state" in same.note
+    lower = choose_end((0.222, 0.214), (True, True), False, 2)
     assert lower.kept == "sub-steps" and not lower.same_state
-    assert "different stable states" in lower.note and "sub-steps" in lower.note
-    assert choose_end(0.214, 0.222, True, 2).kept == "steps"
-    assert choose_end(0.3, 0.1, False, 2).kept == "steps"  # not certified stable
-    failed = choose_end(0.3, np.nan, False, 2)
+    assert "multistable" in lower.note and "(sub-steps)" in lower.note
+    assert choose_end((0.214, 0.222), (True, True), False, 2).kept == "steps"
+    unstable = choose_end((0.3, 0.1), (True, False), False, 2)
+    assert unstable.kept == "steps" and "sub-stepped one is not certified stable" in unstable.note
+    only = choose_end((0.1, 0.3), (False, True), False, 2)  # only the second end is stable
+    assert only.kept == "sub-steps" and "requested one is not certified stable" in only.note
+    failed = choose_end((0.3, np.nan), (True, False), False, 2)
     assert failed.kept == "steps" and "failed" in failed.note
+
+
+@pytest.mark.parametrize("bad", [0, 9, 1.5, 2.0, True, None, "2"])
+def test_check_factor_refuses_anything_but_small_integers(bad):
     with pytest.raises(InvalidParameterError, match="path_check"):
-        check_factor(0)
-    with pytest.raises(InvalidParameterError, match="path_check"):
-        check_factor(1.5)  # type: ignore[arg-type]
+        check_factor(bad)
+    assert check_factor(np.int64(3)) == 3
+
+
+def test_gaps_are_put_in_the_row_of_the_step_they_lead_to():
+    up = np.array([0.0, 1.0, 2.0, 3.0])
+    gaps = _gaps_per_step({0.5: -0.1, 1.0: 0.2, 2.5: 0.3, 2.75: -0.4}, up)
+    np.testing.assert_array_equal(np.isnan(gaps), [True, False, True, False])
+    assert gaps[1] == -0.1 and gaps[3] == -0.4  # the lowest gap within a step
+    down = up[::-1]
+    gaps = _gaps_per_step({2.5: -0.2, 0.0: 0.1}, down)
+    assert gaps[1] == -0.2 and gaps[3] == 0.1 and np.isnan(gaps[[0, 2]]).all()
 
 
 def _small():
     return sinusoidal_lattice(3, 5.0, 1.25, 6, "dome")
 
 
-def test_path_check_records_and_keeps_the_lower_end():
-    direct = [heat_lattice(_small(), steps=n) for n in (2, 4)]
+def test_path_check_records_both_ramps():
+    plain = heat_lattice(_small(), steps=2)
     res = heat_lattice(_small(), steps=2, path_check=2)
-    assert len(res.parameter) == 3 and res.path_check is not None
-    e2, e4 = (float(d.energy[-1]) for d in direct)
-    assert res.path_check.energy == pytest.approx((e2, e4), rel=1e-12)
-    assert float(res.energy[-1]) == pytest.approx(min(e2, e4) if not res.path_check.same_state
-                                                  else e2, rel=1e-12)  # fmt: skip
-    assert heat_lattice(_small(), steps=2).path_check is None
+    four = heat_lattice(_small(), steps=4)
+    check = res.path_check
+    assert check is not None and len(res.parameter) == 3
+    assert check.energy == pytest.approx((plain.energy[-1], four.energy[-1]), rel=1e-12, abs=1e-15)
+    assert check.discarded_iterations == (
+        four.total_iterations if check.kept == "steps" else plain.total_iterations
+    )
+    assert plain.path_check is None
 
 
 def test_kept_sub_stepped_ramp_is_sampled_at_the_requested_steps(monkeypatch):
-    def prefer_sub_steps(energy, other, ok, factor):  # type: ignore[no-untyped-def]
-        return PathCheck(factor, (energy, other), "sub-steps", False)
+    def prefer_sub_steps(energy, stable, same, factor):  # type: ignore[no-untyped-def]
+        return PathCheck(factor, energy, stable, "sub-steps", False)
 
     monkeypatch.setattr(heating, "choose_end", prefer_sub_steps)
     res = heat_lattice(_small(), steps=2, path_check=2)
@@ -61,5 +97,37 @@ def test_kept_sub_stepped_ramp_is_sampled_at_the_requested_steps(monkeypatch):
     np.testing.assert_array_equal(res.parameter, fine.parameter[::2])
     np.testing.assert_allclose(res.positions, fine.positions[::2], atol=1e-12)
     np.testing.assert_allclose(res.energy, fine.energy[::2], rtol=1e-12)
+    np.testing.assert_allclose(res.lowest_eigenvalue[1:], fine.lowest_eigenvalue[2::2], rtol=1e-9)
+    assert res.stable == fine.stable[::2]
     assert res.total_iterations == fine.total_iterations
-    assert res.iterations[1] == fine.iterations[1] + fine.iterations[2]
+    assert list(res.iterations[1:]) == [
+        fine.iterations[1] + fine.iterations[2],
+        fine.iterations[3] + fine.iterations[4],
+    ]
+    assert list(res.halvings[1:]) == [max(fine.halvings[1:3]), max(fine.halvings[3:5])]
+
+
+def test_a_failed_second_ramp_keeps_the_first(monkeypatch):
+    calls = []
+    real = heating.continuation
+
+    def second_fails(*args, **kwargs):  # type: ignore[no-untyped-def]
+        calls.append(1)
+        if len(calls) == 2:
+            raise ConvergenceError("injected")
+        return real(*args, **kwargs)
+
+    plain = heat_lattice(_small(), steps=2)
+    monkeypatch.setattr(heating, "continuation", second_fails)
+    res = heat_lattice(_small(), steps=2, path_check=2)
+    assert res.path_check is not None and res.path_check.kept == "steps"
+    assert "failed" in res.path_check.note
+    np.testing.assert_array_equal(res.iterations, plain.iterations)
+    np.testing.assert_allclose(res.positions, plain.positions, atol=1e-12)
+
+
+def test_path_check_with_friction_is_refused():
+    lat = _small()
+    with pytest.raises(InvalidParameterError, match="path_check"):
+        heat_lattice(lat, steps=1, floor=True, gravity=lattice_gravity(lat), friction=0.3,
+                     path_check=2)  # fmt: skip

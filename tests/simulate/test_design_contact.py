@@ -104,6 +104,11 @@ def test_the_path_check_reaches_the_lattice_ramp_and_is_refused_for_filaments():
     assert lattice_surroundings(design.contact, lattice, 175.0)["path_check"] == 2
     with pytest.raises(InvalidDesignError, match="applies to lattices"):
         parse_design({**RING, "contact": {"self_contact": True, "path_check": 2}})
+    with pytest.raises(InvalidDesignError, match="friction"):
+        parse_design(
+            {"schema_version": 1, "lattice": {"n": 2},
+             "contact": {"floor": True, "friction": 0.3, "path_check": 2}}
+        )  # fmt: skip
     for bad in (0, 9, 1.5):
         with pytest.raises(InvalidDesignError, match="path_check"):
             parse_design({"schema_version": 1, "lattice": {"n": 2}, "contact": {"path_check": bad}})

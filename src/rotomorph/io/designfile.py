@@ -540,7 +540,8 @@ class ContactModel(_Model):
         ge=1,
         le=8,
         description="lattices: also ramp with every step split into this many sub-steps and "
-        "keep the end state lower in total energy where the two differ (1: no check)",
+        "keep the end state lower in total energy where the two differ (1: no check; "
+        "frictionless only)",
     )
 
     @model_validator(mode="after")
@@ -553,6 +554,11 @@ class ContactModel(_Model):
         if not (self.self_contact or self.floor):
             raise ValueError(
                 "nothing to touch: set self_contact = true or floor = true, or remove [contact]"
+            )
+        if self.path_check > 1 and self.friction > 0:
+            raise ValueError(
+                "path_check compares the energies of two ramps, which friction (dissipation) "
+                "does not allow: set path_check = 1 or friction = 0"
             )
         return self
 

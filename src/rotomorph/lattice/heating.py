@@ -45,11 +45,18 @@ from rotomorph.lattice.actuation import (
     get_actuation,
 )
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
-from rotomorph.lattice.paths import PathCheck, check_factor, choose_end, sub_stepped
+from rotomorph.lattice.paths import (
+    SAME_SHAPE_TOL,
+    PathCheck,
+    check_factor,
+    choose_end,
+    shape_distance,
+    sub_stepped,
+)
 from rotomorph.rod.assembly import reference_twist
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
-from rotomorph.solve.continuation import continuation
+from rotomorph.solve.continuation import ContinuationResult, continuation
 from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.stability import stability
@@ -550,6 +557,12 @@ def heat_lattice(
         else None
     )
     factor = check_factor(path_check)
+    if factor > 1 and settings is not None and settings.friction:
+        raise InvalidParameterError(
+            "path_check",
+            "cannot compare paths with friction (lagged friction is dissipation, not an "
+            "energy): use path_check=1 with friction > 0",
+        )
     values = np.linspace(act.start, act.end, int(steps) + 1)
 
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
@@ -592,6 +605,7 @@ def heat_lattice(
         first_events, first_probes = list(events), dict(probes)
         events.clear()
         probes.clear()
+        fine: ContinuationResult | None
         try:
             fine = continuation(
                 solve,
@@ -600,18 +614,38 @@ def heat_lattice(
                 start=values[0],
                 max_halvings=max_halvings,
             )
-            other, ok = fine.final.energy, _stable_flag(fine.final) is True
-        except ConvergenceError:
-            fine, other, ok = None, np.nan, False
-        checked = choose_end(path.final.energy, other, ok, factor)
+        except (ConvergenceError, InfeasibleContactError):
+            fine = None
+        same = fine is not None and shape_distance(
+            path.final.positions, fine.final.positions
+        ) <= SAME_SHAPE_TOL * float(np.min(lattice.radius))
+        checked = choose_end(
+            (path.final.energy, np.nan if fine is None else fine.final.energy),
+            (
+                _stable_flag(path.final) is True,
+                fine is not None and _stable_flag(fine.final) is True,
+            ),
+            same,
+            factor,
+        )
+        second_events = list(events)
+        discarded: tuple[list[tuple[float, int, bool]], ContinuationResult | None]
         if checked.kept == "sub-steps":
             assert fine is not None
             finals = fine.results[factor - 1 :: factor]
-            path = fine
+            discarded, path = (first_events, path), fine
         else:
             events[:] = first_events
             probes.clear()
             probes.update(first_probes)
+            discarded = (second_events, fine)
+        checked = replace(
+            checked,
+            discarded_iterations=int(sum(e[1] for e in discarded[0])),
+            discarded_wall_time=0.0
+            if discarded[1] is None
+            else float(sum(st.wall_time for st in discarded[1].steps)),
+        )
     per_step = factor if len(path.steps) > len(finals) else 1  # sub-steps per kept row
     brackets: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)
     if probe_floor is not None and lift_off_tolerance is not None:
@@ -737,8 +771,8 @@ def _lift_probe(
     orientations), where it settles under its weight. It returns ``(best lifted result or
     None, its energy minus the resting one or None, Newton iterations spent)``. A lifted
     result is returned only if it is certified stable, lower in total energy (elastic +
-    weight + barrier) and actually off the floor. A lift found inside a halved sub-step is
-    taken but its gap is recorded under that sub-step's parameter, not in the ramp's rows.
+    weight + barrier) and actually off the floor. A lift found inside a halved or path-check
+    sub-step is recorded in the row of the step it leads to (``_gaps_per_step``).
     """
     diameter = 2.0 * lattice.radius
     if _rise(floor, lattice, resting.positions) > diameter:

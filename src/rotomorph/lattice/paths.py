@@ -19,10 +19,18 @@ import numpy as np
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["SAME_STATE_RTOL", "PathCheck", "check_factor", "choose_end", "sub_stepped"]
+__all__ = [
+    "SAME_SHAPE_TOL",
+    "PathCheck",
+    "check_factor",
+    "choose_end",
+    "shape_distance",
+    "sub_stepped",
+]
 
-#: Relative difference of total energy below which two ramps ended in the same state.
-SAME_STATE_RTOL = 1e-6
+#: Largest node distance (in filament radii), after the best rigid alignment, below which two
+#: end states count as the same state (free lattices drift rigidly by round-off).
+SAME_SHAPE_TOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -36,41 +44,59 @@ class PathCheck:
     energy
         Final total energy of the ramp as requested and of the sub-stepped one (N mm); NaN
         where a ramp failed.
+    stable
+        Whether each ramp's end state was certified stable.
     kept
         ``"steps"`` (the ramp as requested) or ``"sub-steps"`` (the sub-stepped ramp, sampled
         at the requested parameters).
     same_state
-        Both ramps ended in the same state (energies within :data:`SAME_STATE_RTOL`).
+        Both ramps ended in the same state (:data:`SAME_SHAPE_TOL`).
+    discarded_iterations, discarded_wall_time
+        Newton iterations and seconds of the ramp not kept (not in the result's
+        ``iterations`` and ``wall_time``).
     """
 
     factor: int
     energy: tuple[float, float]
+    stable: tuple[bool, bool]
     kept: str
     same_state: bool
+    discarded_iterations: int = 0
+    discarded_wall_time: float = 0.0
 
     @property
     def note(self) -> str:
         """One sentence for reports."""
         e1, e2 = self.energy
         second = f"the ramp with {self.factor} sub-steps per step"
+        if not np.isfinite(e2):
+            return f"path check: {second} failed; the ramp as requested is kept"
         if self.same_state:
             return f"path check: {second} ends in the same state"
-        if not np.isfinite(e2):
-            return f"path check: {second} failed"
+        ends = (
+            f"path check: the ramp as requested and {second} end in different states "
+            f"(total energy {e1:.6g} and {e2:.6g} N mm"
+        )
+        if not all(self.stable):
+            which = "requested" if not self.stable[0] else "sub-stepped"
+            return (
+                f"{ends}; the {which} one is not certified stable); the "
+                f"{'sub-stepped' if self.kept == 'sub-steps' else 'requested'} one is kept"
+            )
         return (
-            f"path check: the ramp as requested and the one with {self.factor} sub-steps per step "
-            f"end in different stable states (total energy {e1:.6g} and {e2:.6g} N mm); the "
-            f"lattice is multistable and the one lower in energy is kept ({self.kept})"
+            f"{ends}, both certified stable): the lattice is multistable and the one lower in "
+            f"total energy is kept ({self.kept})"
         )
 
 
-def check_factor(factor: int) -> int:
+def check_factor(factor: object) -> int:
     """Validate a path-check factor (1: no check)."""
-    if int(factor) != factor or not 1 <= factor <= 8:
+    ok = isinstance(factor, (int, np.integer)) and not isinstance(factor, bool)
+    if not ok or not 1 <= int(factor) <= 8:  # type: ignore[call-overload]
         raise InvalidParameterError(
-            "path_check", f"must be an integer from 1 (no check) to 8 sub-steps; got {factor}"
+            "path_check", f"must be an integer from 1 (no check) to 8 sub-steps; got {factor!r}"
         )
-    return int(factor)
+    return int(factor)  # type: ignore[call-overload]
 
 
 def sub_stepped(values: FloatArray, factor: int) -> FloatArray:
@@ -84,16 +110,25 @@ def sub_stepped(values: FloatArray, factor: int) -> FloatArray:
     return out
 
 
-def choose_end(energy: float, other: float, other_admissible: bool, factor: int) -> PathCheck:
-    """Keep the requested ramp (final total energy ``energy``) unless the sub-stepped one
-    (``other``; NaN if it failed) ends in a different state that is ``other_admissible``
-    (certified stable) and lower in total energy."""
-    e1, e2 = float(energy), float(other)
-    same = bool(
-        np.isfinite(e1)
-        and np.isfinite(e2)
-        and abs(e2 - e1) <= SAME_STATE_RTOL * max(abs(e1), abs(e2), 1e-300)
-    )
-    lower = np.isfinite(e2) and (not np.isfinite(e1) or e2 < e1)
-    kept = "sub-steps" if not same and other_admissible and lower else "steps"
-    return PathCheck(factor, (e1, e2), kept, same)
+def shape_distance(a: FloatArray, b: FloatArray) -> float:
+    """Largest node distance (mm) between two configurations ``(N, 3)`` after the best rigid
+    alignment of ``b`` onto ``a`` (least squares; Kabsch, Acta Cryst. A32, 922 (1976))."""
+    pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    ca, cb = pa - pa.mean(axis=0), pb - pb.mean(axis=0)
+    u, _, vt = np.linalg.svd(cb.T @ ca)
+    d = np.sign(np.linalg.det(u @ vt))
+    rot = u @ np.diag([1.0, 1.0, d]) @ vt
+    return float(np.linalg.norm(cb @ rot - ca, axis=1).max())
+
+
+def choose_end(
+    energy: tuple[float, float], stable: tuple[bool, bool], same_shape: bool, factor: int
+) -> PathCheck:
+    """Which ramp to keep: the requested one unless the sub-stepped one ends in a different
+    state that is certified stable and either lower in total energy or the only stable one.
+    ``energy`` holds both final total energies (NaN for a failed ramp)."""
+    e1, e2 = (float(e) for e in energy)
+    s1, s2 = bool(stable[0]), bool(stable[1]) and np.isfinite(e2)
+    same = bool(np.isfinite(e2) and same_shape)
+    second = not same and s2 and (not s1 or e2 < e1)
+    return PathCheck(factor, (e1, e2), (s1, s2), "sub-steps" if second else "steps", same)

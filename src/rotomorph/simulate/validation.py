@@ -456,6 +456,10 @@ def summarise(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
         "within_2_combined_spreads": within2,
         "fraction_within_2": round(within2 / n, 4) if n else None,
         "fitted_or_input_rows": sum(bool(r["calibration"]) for r in rows),
+        # compared with a measurement that an assumed input was chosen with in view: not a
+        # clean prediction, so not counted (``informed_by``: which input)
+        "informed_rows": [f"{r['quantity']}: {r['condition']} ({r['informed_by']})"
+                          for r in rows if r.get("informed_by")],
         "sign_predictions": len(signs),
         "signs_correct": sum(
             bool(r["predicted"] is not None and r["measured"] is not None
@@ -478,4 +482,10 @@ def summary_line(summary: dict[str, Any]) -> str:
         f"({100 * (summary['fraction_within_2'] or 0):.0f} %); "
         f"{summary['signs_correct']}/{summary['sign_predictions']} signs correct; "
         f"{summary['fitted_or_input_rows']} rows are fits or inputs (not counted)"
+        + (
+            f"; {len(summary['informed_rows'])} row(s) not counted because an assumed input "
+            "was chosen with that measurement in view"
+            if summary.get("informed_rows")
+            else ""
+        )
     )
