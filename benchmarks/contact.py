@@ -7,7 +7,8 @@ to touch, over every ramp step), ``contacts_active`` (at the end), ``stable`` an
 lattices, ``area_ratio`` and ``gaussian_sign``:
 
 * ``contracting-5x5``, ``dome-5x5``, ``saddle-5x5``: the paper's 5 x 5 lattices, 16-step ramp
-  to full actuation, resting on the bath floor under their buoyant weight (silicone oil);
+  to full actuation, resting on the bath floor under their buoyant weight (silicone oil at
+  each ramp temperature, as in ``rotomorph paper``);
   ``lift_off_x`` is the actuation at which a node first rises one filament diameter above
   its printed height (null: never), ``final_lift_mm`` the largest rise at the end;
 * ``composite-coil``: the composite filament (active fraction 0.5) at ω* = 0.06, heated to
@@ -33,7 +34,7 @@ import numpy as np
 from rotomorph.contact import Contact
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.lattice import heat_lattice
-from rotomorph.lattice.heating import lattice_gravity
+from rotomorph.lattice.heating import lattice_buoyancy
 from rotomorph.rod.cases import EulerColumnCase
 from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.static import solve_static
@@ -51,7 +52,7 @@ def _stable(res) -> bool | None:  # type: ignore[no-untyped-def]
 def lattice_case(pattern: str, steps: int) -> dict:
     lat = sinusoidal_lattice(pattern=pattern)
     c0, t0 = time.process_time(), time.perf_counter()
-    res = heat_lattice(lat, steps=steps, floor=True, gravity=lattice_gravity(lat))
+    res = heat_lattice(lat, steps=steps, floor=True, gravity=lattice_buoyancy(lat))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     row = {
         "case": f"{pattern}-5x5",

@@ -652,7 +652,14 @@ def _lattice_section(
                     f"bisected to [{lo:.2f}, {hi:.2f}] °C; the weightless flat lattice buckles "
                     f"at [{b_lo:.2f}, {b_hi:.2f}] °C, so the weight delays lift-off by "
                     f"{0.5 * (lo + hi - b_lo - b_hi):.1f} °C (the paper: a finite delay, "
-                    "larger for the saddle; no number given)",
+                    "larger for the saddle; no number given)"
+                    + (
+                        "; on the counted path (the sub-stepped ramp, lower in end energy): "
+                        "the ramp as requested ends in another state and leaves the floor at "
+                        "another temperature"
+                        if res.path_check is not None and res.path_check.kept == "sub-steps"
+                        else ""
+                    ),
                 )
             )
         if res is not None:
