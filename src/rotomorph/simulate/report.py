@@ -573,7 +573,7 @@ def _lattice_section(
         )
         paths.append(save_figure(f, figs / f"lattice_{pattern}_views.png"))
     # Fig. 4C/F: sign and characteristic curvature vs strain
-    fig = new_figure(10.0, 4.0)
+    fig = new_figure(10.0, 5.0)
     axes = fig.subplots(1, 2)
     for ax, (pattern, sign, panel) in zip(
         axes, (("dome", 1, "4C"), ("saddle", -1, "4F")), strict=True
@@ -690,7 +690,8 @@ def _lattice_section(
             fontsize=10,
         )
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    fig.subplots_adjust(bottom=0.3, wspace=0.3)  # legends below the axes, clear of the data
     if figs is not None:
         paths.append(save_figure(fig, figs / "fig4cf_characteristic_curvature.png"))
     return rows, paths
