@@ -61,6 +61,7 @@ def test_on_the_floor_under_buoyant_weight():
     assert sim.positions[-1, :, 2].max() < floor + 4 * r  # weighed down: stays near the floor
     record = run.metadata["contact"]
     assert record["gravity"] and 0.8 < record["bath_density_g_cm3"] < 0.97  # hot oil, lighter
+    assert record["bath_density_along_ramp"] is False  # a filament: the end temperature
     assert "PDMS" in record["bath_density_assumption"] or record["bath_density_source"]
 
 

@@ -389,7 +389,9 @@ def _simulate_lattice(
         "edge_mode": list(lattice.edge_mode),
         "final": {k: float(v[-1]) for k, v in scalars.items()},
         "actuation_rule": res.actuation,
-        "contact": surroundings_record(design.contact, hot),
+        "contact": surroundings_record(
+            design.contact, hot, along_ramp=actuation in ("thermal", "program")
+        ),
         "assumptions": lattice_assumptions(lattice),
         "lattice_wall_time_s": float(np.sum(res.wall_time)),
         "path_check": None if res.path_check is None else res.path_check.note,

@@ -98,8 +98,12 @@ def lattice_surroundings(
     return kwargs
 
 
-def surroundings_record(contact: Any, temperature: float) -> dict[str, Any] | None:
-    """What the run assumed about its surroundings, for ``summary.json`` and the HDF5 file."""
+def surroundings_record(
+    contact: Any, temperature: float, *, along_ramp: bool = False
+) -> dict[str, Any] | None:
+    """What the run assumed about its surroundings, for ``summary.json`` and the HDF5 file;
+    ``along_ramp``: the buoyancy followed the bath density over the temperature ramp (the
+    density recorded is the one at ``temperature``, the end of the ramp)."""
     if contact is None:
         return None
     record: dict[str, Any] = {
@@ -115,6 +119,7 @@ def surroundings_record(contact: Any, temperature: float) -> dict[str, Any] | No
         record.update(
             bath=contact.bath,
             bath_density_g_cm3=round(bath_density(contact.bath, temperature), 4),
+            bath_density_along_ramp=bool(along_ramp),
             bath_density_source=str(fluid.get("source", "")),
             bath_density_assumption=str(fluid.get("assumptions", "")),
         )
