@@ -61,6 +61,11 @@ def test_curve_target_to_a_design_the_other_commands_accept(tmp_path, capsys):
             "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\ngravity = true\n",
             "contact.branch",
         ),
+        (
+            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
+            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\npath_check = 2\n",
+            "contact.path_check",
+        ),
     ],
 )
 def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):

@@ -25,8 +25,17 @@ def test_example_quick():
     assert not any(r["counted"] for r in recipe)
     calibrated = next(r for r in recipe if r["calibration"])
     assert calibrated["predicted"] == pytest.approx(1.37, abs=1e-3)
-    areas = [r for r in predicted if r["quantity"] == "lattice_area_ratio" and r["counted"]]
+    areas = [
+        r
+        for r in predicted
+        if r["quantity"] == "lattice_area_ratio"
+        and r["condition"] in ("expanding lattice", "contracting lattice")
+    ]
     assert [r["condition"] for r in areas] == ["expanding lattice", "contracting lattice"]
+    # the expanding lattice's assumed A/l was chosen with its measured area in view: shown,
+    # labelled, never counted; the contracting one is counted
+    assert not areas[0]["counted"] and areas[0]["informed_by"]
+    assert areas[1]["counted"]
     assert all(isinstance(r["converged"], bool) for r in predicted)
     assert areas[0]["predicted"] > 1.0 > areas[1]["predicted"]
     # the 3 x 3 quick lattices are too small for a curvature sign; the recipe's are exact

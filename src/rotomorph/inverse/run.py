@@ -205,6 +205,7 @@ def run_inverse(
     env = lattice_surroundings(target.contact, lat, opt.temperature)
     env.pop("friction", None)  # 0: the target file refuses friction
     env.pop("branch", None)  # 'continuous' wherever it matters: the target file refuses the probe
+    env.pop("path_check", None)  # 1: the target file refuses a path check
     des = design_lattice(
         lat,
         surf,

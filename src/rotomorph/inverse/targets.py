@@ -25,8 +25,8 @@ Lattice targets (``dome``, ``saddle``, ``height_map``) give the curvatures (1/mm
 grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``amplitude``,
 ``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
 An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``, ``gravity``,
-``bath``, ``branch``; frictionless only; with ``floor`` and ``gravity`` the branch must be
-``"continuous"``) makes every equilibrium of a lattice design, and its adjoint, touch and rest as
+``bath``, ``branch``; frictionless only, no ``path_check``; with ``floor`` and ``gravity`` the
+branch must be ``"continuous"``) makes every equilibrium of a lattice design, and its adjoint, touch and rest as
 ``rotomorph simulate`` will; it is copied into the resulting design file.
 """
 
@@ -160,6 +160,11 @@ class TargetFile(_Model):
                 "contact.branch must be 'continuous' with floor and gravity: inverse design "
                 "follows the resting state continuously (no lowest-energy lift probe); set "
                 'branch = "continuous" in [contact]'
+            )
+        if self.contact is not None and self.contact.path_check != 1:
+            raise ValueError(
+                "contact.path_check must be 1: inverse design follows one continuous path "
+                "(its adjoint differentiates that path); remove path_check from [contact]"
             )
         if self.options.min_speed >= self.options.max_speed:
             raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
