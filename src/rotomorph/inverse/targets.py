@@ -26,8 +26,8 @@ grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``
 ``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
 An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``, ``gravity``,
 ``bath``, ``branch``; frictionless only, no ``path_check``; with ``floor`` and ``gravity`` the
-branch must be ``"continuous"``) makes every equilibrium of a lattice design, and its adjoint, touch and rest as
-``rotomorph simulate`` will; it is copied into the resulting design file.
+branch must be ``"continuous"``) makes every equilibrium of a lattice design, and its adjoint,
+touch and rest as ``rotomorph simulate`` will; it is copied into the resulting design file.
 """
 
 from __future__ import annotations
