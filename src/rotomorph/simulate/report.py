@@ -492,7 +492,16 @@ def _lattice_section(
         lifted = None if touched is None else touched.first_lift_off()
         resting = None
         if not quick and lifted is not None:
-            _, resting, why_r = _heat(pattern, quick, steps, model, coarse_g, True, "continuous")
+            _, resting, why_r = _heat(
+                pattern,
+                quick,
+                steps,
+                model,
+                coarse_g,
+                True,
+                "continuous",
+                path_check=PATH_CHECK_FACTOR,
+            )
             rows.append(
                 _row(
                     "lattice_area_ratio",
@@ -509,7 +518,8 @@ def _lattice_section(
                     "weight × height to first order), where the counted row takes the "
                     f"lifted equilibrium of lower energy from {lifted:.4g} °C on; largest "
                     f"rise {float(resting.floor_lift[-1]):.2f} mm, "
-                    f"{int(resting.contacts_active[-1])} contacts",
+                    f"{int(resting.contacts_active[-1])} contacts; "
+                    + ("" if resting.path_check is None else resting.path_check.note),
                 )
             )
         if not quick and res is not None:
