@@ -618,7 +618,7 @@ def heat_lattice(
             fine = None
         same = fine is not None and shape_distance(
             path.final.positions, fine.final.positions
-        ) <= SAME_SHAPE_TOL * float(np.min(lattice.radius))
+        ) <= SAME_SHAPE_TOL * float(lattice.radius)
         checked = choose_end(
             (path.final.energy, np.nan if fine is None else fine.final.energy),
             (
@@ -628,23 +628,22 @@ def heat_lattice(
             same,
             factor,
         )
-        second_events = list(events)
-        discarded: tuple[list[tuple[float, int, bool]], ContinuationResult | None]
+        dropped: ContinuationResult | None
         if checked.kept == "sub-steps":
             assert fine is not None
-            finals = fine.results[factor - 1 :: factor]
-            discarded, path = (first_events, path), fine
+            dropped_events, dropped = first_events, path
+            finals, path = fine.results[factor - 1 :: factor], fine
         else:
+            dropped_events, dropped = list(events), fine
             events[:] = first_events
             probes.clear()
             probes.update(first_probes)
-            discarded = (second_events, fine)
         checked = replace(
             checked,
-            discarded_iterations=int(sum(e[1] for e in discarded[0])),
+            discarded_iterations=sum(e[1] for e in dropped_events),
             discarded_wall_time=0.0
-            if discarded[1] is None
-            else float(sum(st.wall_time for st in discarded[1].steps)),
+            if dropped is None
+            else sum(st.wall_time for st in dropped.steps),
         )
     per_step = factor if len(path.steps) > len(finals) else 1  # sub-steps per kept row
     brackets: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)

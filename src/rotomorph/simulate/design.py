@@ -349,6 +349,7 @@ def _simulate_lattice(
     lattice = lat.to_lattice()
     rule = _lattice_actuation(actuation, start_temperature, temperature, model)
     hot = float(getattr(rule, "end", ACTUATION_TEMPERATURE))  # x-readings: the paper's 175 °C
+    in_temperature = actuation in ("thermal", "program")  # else the ramp is an abstract x
     res = heat_lattice(
         lattice,
         actuation=rule,
@@ -357,7 +358,7 @@ def _simulate_lattice(
             design.contact,
             lattice,
             hot,
-            ramp_in_temperature=actuation in ("thermal", "program"),
+            ramp_in_temperature=in_temperature,
         ),
     )
     if progress is not None:
@@ -365,7 +366,7 @@ def _simulate_lattice(
     phase_log.info("analysis: curvature changes, areas")
     pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
     rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])
-    ramp = "temperature" if actuation in ("thermal", "program") else "actuation"
+    ramp = "temperature" if in_temperature else "actuation"
     scalars = {
         ramp: np.asarray(res.parameter, dtype=float),
         "energy": np.asarray(res.energy, dtype=float),
@@ -389,9 +390,7 @@ def _simulate_lattice(
         "edge_mode": list(lattice.edge_mode),
         "final": {k: float(v[-1]) for k, v in scalars.items()},
         "actuation_rule": res.actuation,
-        "contact": surroundings_record(
-            design.contact, hot, along_ramp=actuation in ("thermal", "program")
-        ),
+        "contact": surroundings_record(design.contact, hot, along_ramp=in_temperature),
         "assumptions": lattice_assumptions(lattice),
         "lattice_wall_time_s": float(np.sum(res.wall_time)),
         "path_check": None if res.path_check is None else res.path_check.note,

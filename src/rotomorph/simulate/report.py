@@ -423,6 +423,8 @@ def _lattice_section(
         touched = resolved.get(pattern, (None, None, ""))[1]
         measured = 1.0 + float(table.value[i]) / 100.0
         spread = float(table.spread[i]) / 100.0
+        # the expanding lattice's assumed A/l was chosen with its measured area in view
+        informed = pattern == "expanding"
         if quick:
             how = (
                 f"quick mode: no contact (min clearance {np.min(res.min_clearance):.2f} diameters)"
@@ -467,12 +469,12 @@ def _lattice_section(
                     "but the assumed A/l = 0.25 was chosen in the package's first version "
                     "inside the range that reproduced this area with the paper's curvature-"
                     "rescaling recipe, so the row is not a clean prediction and is not counted"
-                    if pattern == "expanding"
+                    if informed
                     else "the assumed A/l = 0.25 was chosen with the expanding lattice's area "
                     "in view"
                 ),
-                counted=None if pattern != "expanding" else False,
-                informed_by="A/l chosen with it in view" if pattern == "expanding" else None,
+                counted=False if informed else None,
+                informed_by="A/l chosen with it in view" if informed else None,
                 unit="1",
                 figure="fig3g_lattice_area.png",
                 note=why

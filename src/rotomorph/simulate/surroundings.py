@@ -80,7 +80,7 @@ def lattice_surroundings(
     temperature (:func:`rotomorph.lattice.heating.lattice_buoyancy`)."""
     if contact is None:
         return {}
-    from rotomorph.lattice.heating import lattice_buoyancy, lattice_gravity  # lattice-only
+    from rotomorph.lattice.heating import lattice_buoyancy  # lattice-only
 
     kwargs: dict[str, Any] = {
         "contact": Contact(radius=lattice.radius, self_contact=contact.self_contact),
@@ -90,11 +90,8 @@ def lattice_surroundings(
         "path_check": int(contact.path_check),
     }
     if contact.gravity:
-        kwargs["gravity"] = (
-            lattice_buoyancy(lattice, bath=contact.bath)
-            if ramp_in_temperature
-            else lattice_gravity(lattice, fluid_density=bath_density(contact.bath, temperature))
-        )
+        weight = lattice_buoyancy(lattice, bath=contact.bath)
+        kwargs["gravity"] = weight if ramp_in_temperature else weight(temperature)
     return kwargs
 
 
