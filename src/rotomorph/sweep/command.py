@@ -17,7 +17,7 @@ from typing import Any
 
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["add_arguments", "command"]
+__all__ = ["add_arguments", "check_scheduler_address", "command"]
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -28,6 +28,34 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=int, help="local worker processes (default: CPU count)")
     p.add_argument("--plot", action="store_true", help="draw the sweep's figures in DIR/figures")
     p.add_argument("--schema", action="store_true", help="print the sweep file's JSON Schema")
+
+
+def check_scheduler_address(address: str) -> None:
+    """Refuse a ``--scheduler`` that is not a Dask scheduler address (before any folder exists).
+
+    Raises
+    ------
+    InvalidParameterError
+        A missing port, an unknown scheme (e.g. the dashboard's ``http://HOST:8787``), or no
+        dask.distributed installed; naming ``--scheduler`` and the expected form.
+    """
+    form = "write tcp://HOST:PORT (the scheduler's port, 8786 by default; not the dashboard's)"
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import get_backend
+    except ImportError:  # pragma: no cover - optional dependency
+        raise InvalidParameterError(
+            "--scheduler", "needs dask.distributed: pip install 'rotomorph[sweep]'"
+        ) from None
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as err:
+        raise InvalidParameterError(
+            "--scheduler", f"{address!r} is not a Dask scheduler address ({err}); {form}"
+        ) from None
 
 
 class _Bar:
@@ -58,7 +86,8 @@ class _Bar:
 
 
 def command(args: argparse.Namespace) -> int:
-    """Run ``rotomorph sweep``; returns the exit code (bad input raises InvalidParameterError)."""
+    """Run a parameter study from SWEEP.toml into DIR (resumable: the same command finishes an
+    interrupted sweep), on local processes or a Dask scheduler."""
     from rotomorph.sweep.spec import load_sweep, sweep_schema
 
     if args.schema:
@@ -74,6 +103,8 @@ def command(args: argparse.Namespace) -> int:
         raise InvalidParameterError("SWEEP", f"{args.sweep}: no such file")
     if args.scheduler is not None and args.workers is not None:
         raise InvalidParameterError("--workers", "is for the local pool; drop it with --scheduler")
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     out = Path(args.output)
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise InvalidParameterError("-o/--output", f"{out.parent}: parent folder does not exist")

@@ -16,7 +16,7 @@ from typing import Any
 
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["parse_path", "set_path"]
+__all__ = ["check_path", "parse_path", "set_path"]
 
 _KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[(?:\d+|\*)\])*)$")
 _INDEX = re.compile(r"\[(\d+|\*)\]")
@@ -61,13 +61,26 @@ def _describe(steps: tuple[Step, ...]) -> str:
     return out
 
 
-def _set(node: Any, steps: tuple[Step, ...], value: Any, done: tuple[Step, ...]) -> None:
+def _set(
+    node: Any, steps: tuple[Step, ...], value: Any, done: tuple[Step, ...], strict: bool
+) -> None:
     head, rest = steps[0], steps[1:]
     where = _describe(done) or "<design>"
     if isinstance(head, str):
+        if node is None:
+            raise InvalidParameterError(
+                _describe((*done, head)),
+                f"the base design has no {where}; add it to the base design first",
+            )
         if not isinstance(node, dict):
             raise InvalidParameterError(_describe((*done, head)), f"{where} is not a table")
         if not rest:
+            if strict and head not in node:
+                raise InvalidParameterError(
+                    _describe((*done, head)),
+                    f"{where} has no field {head!r}; check its spelling (its fields: "
+                    f"{', '.join(sorted(node))})",
+                )
             node[head] = copy.deepcopy(value)
             return
         if head not in node:
@@ -75,7 +88,7 @@ def _set(node: Any, steps: tuple[Step, ...], value: Any, done: tuple[Step, ...])
                 _describe((*done, head)),
                 f"the base design has no {head!r} in {where}; set it in the base design first",
             )
-        _set(node[head], rest, value, (*done, head))
+        _set(node[head], rest, value, (*done, head), strict)
         return
     if not isinstance(node, list):
         raise InvalidParameterError(_describe((*done, head)), f"{where} is not a list")
@@ -86,7 +99,7 @@ def _set(node: Any, steps: tuple[Step, ...], value: Any, done: tuple[Step, ...])
         )
     for i in indices:
         if rest:
-            _set(node[i], rest, value, (*done, i))
+            _set(node[i], rest, value, (*done, i), strict)
         else:
             node[i] = copy.deepcopy(value)
 
@@ -103,5 +116,27 @@ def set_path(data: Mapping[str, Any], path: str, value: Any) -> dict[str, Any]:
     {'filaments': [{'speed': 1.5}]}
     """
     out = copy.deepcopy(dict(data))
-    _set(out, parse_path(path), value, ())
+    _set(out, parse_path(path), value, (), strict=False)
     return out
+
+
+def check_path(resolved: Mapping[str, Any], path: str) -> None:
+    """Refuse a ``path`` that names no field of ``resolved`` (a design with every default
+    filled in, e.g. ``Design.model_dump(mode="json")``): a misspelt key, an index past a list,
+    a table the design does not have. Values are not checked (a sweep records out-of-range
+    points as invalid runs).
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the first step of ``path`` that does not exist and what does.
+
+    Examples
+    --------
+    >>> check_path({"filaments": [{"speed": 3.0}]}, "filaments[0].sped")
+    Traceback (most recent call last):
+    ...
+    rotomorph.errors.InvalidParameterError: filaments[0].sped: filaments[0] has no field 'sped'; \
+check its spelling (its fields: speed)
+    """
+    _set(copy.deepcopy(dict(resolved)), parse_path(path), None, (), strict=True)

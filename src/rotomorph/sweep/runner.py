@@ -140,7 +140,7 @@ def _executor(executor: Any, scheduler: str | None, workers: int | None) -> Iter
             ) from None
         try:
             client = Client(scheduler, timeout="20s")
-        except OSError as err:
+        except (OSError, ValueError) as err:  # unreachable, or not an address (no port)
             raise InvalidParameterError(
                 "scheduler", f"cannot reach the Dask scheduler at {scheduler}: {err}"
             ) from None

@@ -43,7 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rotomorph.errors import InvalidDesignError, InvalidParameterError
 from rotomorph.io.designfile import Design, parse_design
 from rotomorph.io.machine import MachineProfile, load_machine_profile
-from rotomorph.sweep.paths import parse_path
+from rotomorph.sweep.paths import check_path, parse_path
 
 try:  # Python >= 3.11
     import tomllib
@@ -335,6 +335,14 @@ def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
         design = sweep.base_design()
     except InvalidDesignError as err:
         raise InvalidDesignError(f"design.{err.field}", str(err).partition(": ")[2]) from None
+    resolved = design.model_dump(mode="json")
+    for i, parameter in enumerate(sweep.parameters):
+        try:  # a misspelt path would make every point an invalid run
+            check_path(resolved, parameter.path)
+        except InvalidParameterError as err:
+            raise InvalidParameterError(
+                f"parameters[{i}].path", str(err)
+            ) from None
     sweep.machine_profile()
     check_outputs(sweep.outputs, design, sweep.settings.method)
     return sweep
