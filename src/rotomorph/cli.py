@@ -194,12 +194,16 @@ def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
         raise UsageError(f"-o/--output: {path}: exists and is not a folder")
     if target.is_dir() and any(target.iterdir()) and not force:
         raise UsageError(f"-o/--output: {path}: folder is not empty; use --force to replace it")
-    parent = target.parent if str(target.parent) else Path(".")
-    if parent.exists() and not parent.is_dir():
-        raise UsageError(f"-o/--output: {parent}: exists and is not a folder")
-    parent.mkdir(parents=True, exist_ok=True)
+    _check_writable(target, create_parent=True)
     with atomic_folder(target) as tmp:
         yield tmp
+
+
+def _check_writable(path: Path, *, create_parent: bool) -> None:
+    """Refuse an -o/--output that cannot be written, before any computation."""
+    from rotomorph.io.atomic import check_writable
+
+    check_writable(path, "-o/--output", create_parent=create_parent)
 
 
 def _print(text: str) -> None:
@@ -301,8 +305,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise UsageError(f"-o/--output: {out.parent}: folder does not exist")
+    _check_writable(out, create_parent=False)
     machine = _machine(args)
     programs = design.to_programs()
     _check_materials(programs)
@@ -381,6 +384,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         raise UsageError("-o/--output: empty path; give a folder name")
     if out.exists() and not out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: exists and is not a folder")
+    _check_writable(out / "shapes.png" if out.is_dir() else out, create_parent=True)
     paths = plot_run(results, out, movie=not args.no_movie)
     _print(f"wrote {len(paths)} file(s) to {args.output}")
     return EXIT_OK
@@ -393,7 +397,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else path.parent / "view.html"
     if out.is_dir():
         raise UsageError(f"-o/--output: {out}: is a folder; give an .html file name")
-    out.parent.mkdir(parents=True, exist_ok=True)
+    _check_writable(out, create_parent=True)
     write_viewer(results, out, field=args.field)
     _print(f"wrote {out}")
     if args.open:
@@ -437,6 +441,7 @@ def _cmd_inverse(args: argparse.Namespace) -> int:
         raise UsageError("-o/--output: give the design file to write, ending in .toml")
     if out.exists() and not args.force:
         raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
+    _check_writable(out, create_parent=True)
     with _progress(0, "inverse") as bar:
         text = inverse_file(target, out, progress=lambda it, j: bar.update(1))
     _print(text)

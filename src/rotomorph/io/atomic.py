@@ -37,11 +37,14 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from rotomorph.errors import InvalidParameterError
+
 __all__ = [
     "atomic_folder",
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
+    "check_writable",
     "remove_stale",
     "temporary_prefix",
 ]
@@ -147,6 +150,61 @@ def _remove_stale_once(folder: Path) -> None:
     if key not in _CLEANED:
         _CLEANED.add(key)
         remove_stale(folder)
+
+
+def check_writable(path: str | os.PathLike[str], field: str, *, create_parent: bool) -> Path:
+    """Refuse, before any work, an output ``path`` whose folder cannot take a new file.
+
+    Parameters
+    ----------
+    path
+        The file or folder to be written; its parent folder receives the temporaries.
+    field
+        Name of the option or argument that gave ``path`` (e.g. ``"-o/--output"``).
+    create_parent
+        Create missing parent folders (else a missing parent is refused).
+
+    Returns
+    -------
+    pathlib.Path
+        The parent folder.
+
+    Raises
+    ------
+    InvalidParameterError
+        The parent (or a folder above it) is a file, is missing (without ``create_parent``),
+        cannot be created, or does not accept a new file (read-only, a virtual file system).
+    """
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    above = parent
+    while not above.exists() and above != above.parent:
+        above = above.parent
+    if above.exists() and not above.is_dir():
+        raise InvalidParameterError(
+            field, f"{path}: {above} is a file, not a folder; choose another path"
+        )
+    if not parent.exists():
+        if not create_parent:
+            raise InvalidParameterError(
+                field, f"{path}: folder {parent} does not exist; create it first"
+            )
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise InvalidParameterError(
+                field, f"{path}: cannot create folder {parent} ({err.strerror or err})"
+            ) from None
+    try:
+        with tempfile.TemporaryFile(dir=parent, prefix=temporary_prefix(target)):
+            pass
+    except OSError as err:
+        raise InvalidParameterError(
+            field,
+            f"{path}: cannot write in {parent} ({err.strerror or err}); choose a folder you "
+            "can write to",
+        ) from None
+    return parent
 
 
 _RENAME_EXCHANGE = 2

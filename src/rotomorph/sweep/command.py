@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from rotomorph.errors import InvalidParameterError
+from rotomorph.io.atomic import check_writable
 
 __all__ = ["add_arguments", "check_scheduler_address", "command"]
 
@@ -106,8 +107,9 @@ def command(args: argparse.Namespace) -> int:
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
     out = Path(args.output)
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise InvalidParameterError("-o/--output", f"{out.parent}: parent folder does not exist")
+    if out.exists() and not out.is_dir():
+        raise InvalidParameterError("-o/--output", f"{args.output}: exists and is not a folder")
+    check_writable(out, "-o/--output", create_parent=False)
     sweep = load_sweep(path)
     from rotomorph.sweep.runner import run_sweep
 

@@ -340,9 +340,7 @@ def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
         try:  # a misspelt path would make every point an invalid run
             check_path(resolved, parameter.path)
         except InvalidParameterError as err:
-            raise InvalidParameterError(
-                f"parameters[{i}].path", str(err)
-            ) from None
+            raise InvalidParameterError(f"parameters[{i}].path", str(err)) from None
     sweep.machine_profile()
     check_outputs(sweep.outputs, design, sweep.settings.method)
     return sweep
