@@ -256,3 +256,27 @@ def test_movie_falls_back_to_a_gif_without_ffmpeg(tmp_path, monkeypatch):
             im.seek(k)
             durations.append(im.info["duration"])
     assert sum(durations) >= 5000  # ms: held frames make at least 5 s
+
+
+def test_end_to_end_figure_rings_each_filament_by_its_own_verdict(run_file):
+    # The coil overlaps itself at the end of the ramp; the straight filament passes every
+    # check. Before: end_to_end_ratio.png ringed both filaments at every step where the *run*
+    # was not physical, so a physical filament was drawn as not physical (ramp.png and
+    # summary.json said otherwise).
+    from rotomorph.simulate.outputs import _filament_figure, _verdicts
+
+    res = read_results(run_file)
+    meta = json.loads(json.dumps(res.metadata))
+    meta["filaments"][0]["physical"] = {"steps": ["yes", "unknown", "no"], "verdict": "no"}
+    meta["filaments"][1]["physical"] = {"steps": ["yes", "unknown", "yes"], "verdict": "unknown"}
+    res = dataclasses.replace(res, metadata=meta)
+    fig = _filament_figure(res, _verdicts(res))
+    ax = fig.axes[0]
+    ringed = [
+        (tuple(line.get_xdata()), tuple(np.round(line.get_ydata(), 6)))
+        for line in ax.get_lines()
+        if line.get_markerfacecolor() == "none" and len(line.get_xdata())
+    ]
+    coil_end = round(float(res.fields["end_to_end_ratio_per_filament"][-1, 0]), 6)
+    assert ringed == [((175.0,), (coil_end,))]
+    assert "not physical" in [t.get_text() for t in ax.get_legend().get_texts()]

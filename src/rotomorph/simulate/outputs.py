@@ -292,12 +292,19 @@ def _filament_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     ratios = results.fields.get("end_to_end_ratio_per_filament")
     if ratios is None:
         ratios = results.scalars["end_to_end_ratio"][:, None]
-    bad = np.array([v.verdict == "no" for v in verdicts])
+    any_bad = False
+    colours = [f"C{i}" for i in range(10) if i != 3]  # C3 is red: the rings' colour
     for j, (name, _, _) in enumerate(_chains(results)):
-        ax.plot(t, ratios[:, j], marker="o", ms=3, label=name or f"filament {j}")
+        colour = colours[j % len(colours)]
+        ax.plot(t, ratios[:, j], marker="o", ms=3, color=colour, label=name or f"filament {j}")
+        # each filament's own verdict per step (as ramp.png), not the run's
+        bad = np.array(
+            [_filament_step_verdict(results, j, k, verdicts) == "no" for k in range(len(t))]
+        )
         if bad.any():
+            any_bad = True
             ax.plot(t[bad], ratios[bad, j], "o", ms=7, mfc="none", mec=_RED)
-    if bad.any():
+    if any_bad:
         ax.plot([], [], "o", ms=7, mfc="none", mec=_RED, label="not physical")
     ax.set_xlabel("temperature (°C)" if "temperature" in results.scalars else "step")
     ax.set_ylabel("L/L0 (–)")
