@@ -416,6 +416,7 @@ def _header(
     else:
         origin = f"profile {m.source}"
     f_unit = "mm/s" if m.dialect == "aerotech" else "mm/min"
+    dwell_unit = "ms" if "{ms}" in (m.dwell_template or "") else "s"  # as G4 P is written
     turn = "360 deg" if m.rotary_units == "deg" else "2pi rad"
     rebase = (
         f"re-based with G92 between filaments (restored at the end), |{m.rotary_axis}| <= {turn}"
@@ -431,7 +432,8 @@ def _header(
         f"{m.min_feed:g}..{m.max_feed:g} mm/s, rotation <= {m.max_rotation:g} rad/s (travel "
         f"included), pressure {m.min_pressure:g}..{m.max_pressure:g} psi, lift {m.lift:g} mm",
         f"; dialect: {m.dialect}, pressure idiom {m.pressure_idiom}",
-        f"; units: length mm, feed {f_unit}, rotary {m.rotary_units}, pressure psi, dwell s",
+        f"; units: length mm, feed {f_unit}, rotary {m.rotary_units}, pressure psi, dwell "
+        f"{dwell_unit}",
         f"; axes: {m.x_axis}=x {m.y_axis}=y {m.z_axis}=z (design z + z_offset {m.z_offset:g} "
         "mm; Z 0 = substrate surface in the active work offset)",
         f"; rotary: {m.rotary_axis} = nozzle angle of the active half, counter-clockwise from +x "
@@ -605,7 +607,12 @@ def _travel(w: _Writer, k: int, start: np.ndarray, zt: float, angle: float) -> N
 
 def _cure(w: _Writer, layer: int | None, seconds: float) -> None:
     m = w.m
-    w.emit(f"; UV cure after layer {layer}: {seconds:g} s")
+    manual = (
+        ""
+        if m.uv_on_template
+        else " (no UV command in the machine profile: switch the lamp by hand)"
+    )
+    w.emit(f"; UV cure after layer {layer}: {seconds:g} s{manual}")
     if m.uv_on_template:
         w.emit(m.uv_on_template)
     w.dwell(seconds)

@@ -48,7 +48,7 @@ Call setAlicatPress P5 Q0
 Call setAlicatPress P6 Q0
 ; end filament 1
 G0 Z2.9
-; UV cure after layer 0: 60 s
+; UV cure after layer 0: 60 s (no UV command in the machine profile: switch the lamp by hand)
 G4 P60
 ; layer 1
 ; filament 2 layer=1 radius=0.3 active_fraction=1.0 active_material=lce passive_material=acrylate
@@ -64,7 +64,7 @@ G1 X12 Y10 C-381.971863
 Call setAlicatPress P5 Q0
 ; end filament 2
 G0 Z2.9
-; UV cure after layer 1: 60 s
+; UV cure after layer 1: 60 s (no UV command in the machine profile: switch the lamp by hand)
 G4 P60
 G92 C-21.971863
 M2

@@ -4,7 +4,7 @@
 ; machine: golden, built-in default (no machine profile given: its envelope and limits are assumptions; pass --machine FILE for your printer)
 ; limits: envelope [0.0, 0.0, 0.0]..[300.0, 300.0, 100.0] mm, feed 0.01..50 mm/s, rotation <= 40 rad/s (travel included), pressure 0..100 psi, lift 2 mm
 ; dialect: marlin, pressure idiom template
-; units: length mm, feed mm/min, rotary deg, pressure psi, dwell s
+; units: length mm, feed mm/min, rotary deg, pressure psi, dwell ms
 ; axes: X=x Y=y Z=z (design z + z_offset 0 mm; Z 0 = substrate surface in the active work offset)
 ; rotary: C = nozzle angle of the active half, counter-clockwise from +x seen from above times sign +1; must read 0 with the active half toward +x at the start; cumulative within a filament, re-based with G92 between filaments (restored at the end), |C| <= 360 deg
 ; pressure channels: active port 5, passive port 6
@@ -43,7 +43,7 @@ M42 P5 S0
 M42 P6 S0
 ; end filament 1
 G0 Z2.9 F1200
-; UV cure after layer 0: 60 s
+; UV cure after layer 0: 60 s (no UV command in the machine profile: switch the lamp by hand)
 G4 P60000
 ; layer 1
 ; filament 2 layer=1 radius=0.3 active_fraction=1.0 active_material=lce passive_material=acrylate
@@ -57,6 +57,6 @@ G1 X12 Y10 C-381.971863 F120
 M42 P5 S0
 ; end filament 2
 G0 Z2.9 F1200
-; UV cure after layer 1: 60 s
+; UV cure after layer 1: 60 s (no UV command in the machine profile: switch the lamp by hand)
 G4 P60000
 G92 C-21.971863

@@ -1,0 +1,40 @@
+"""G-code as the printer's operator reads it: the header states the units the program uses."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from rotomorph.io.designfile import load_design
+from rotomorph.io.gcode import gcode_text
+from rotomorph.io.machine import MachineProfile, load_machine_profile
+
+ROOT = Path(__file__).resolve().parents[2]
+PROFILES = sorted((ROOT / "examples" / "machines").glob("*.toml"))
+
+
+def _program(machine: MachineProfile, cure: float) -> str:
+    design = load_design(ROOT / "examples" / "designs" / "sinusoids.toml")
+    return gcode_text(design.to_programs(), machine, layer_cure_s=cure, **design.gcode_options())
+
+
+@pytest.mark.parametrize("profile", PROFILES, ids=lambda p: p.stem)
+def test_header_dwell_unit_is_the_unit_of_the_written_dwells(profile):
+    # before: every header said "dwell s" while Marlin, Klipper and RepRapFirmware programs
+    # write G4 P<ms>: an operator read 'G4 P12500' as a dwell of 12500 s
+    text = _program(load_machine_profile(profile), cure=12.5)
+    unit = re.search(r"^; units: .*, dwell (\w+)$", text, re.M)
+    assert unit is not None
+    dwells = re.findall(r"^G4 P(\S+)$", text, re.M)
+    assert dwells, "the cure dwell is written"
+    assert {float(p) for p in dwells} == {12500.0 if unit[1] == "ms" else 12.5}
+
+
+def test_a_cure_without_uv_commands_says_the_lamp_is_switched_by_hand():
+    plain = _program(MachineProfile(dialect="rs274"), cure=5.0)
+    assert "; UV cure after layer 0: 5 s (no UV command in the machine profile: switch" in plain
+    lamp = MachineProfile(dialect="rs274", uv_on_template="M7", uv_off_template="M9")
+    text = _program(lamp, cure=5.0)
+    assert "; UV cure after layer 0: 5 s\nM7\nG4 P5\nM9\n" in text
