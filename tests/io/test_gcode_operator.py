@@ -38,3 +38,31 @@ def test_a_cure_without_uv_commands_says_the_lamp_is_switched_by_hand():
     lamp = MachineProfile(dialect="rs274", uv_on_template="M7", uv_off_template="M9")
     text = _program(lamp, cure=5.0)
     assert "; UV cure after layer 0: 5 s\nM7\nG4 P5\nM9\n" in text
+
+
+def test_checking_a_program_against_another_dialect_says_so():
+    # before: "line 15: unexpected command: 'G94'" (an RS-274 program checked as Marlin)
+    from rotomorph.errors import GcodeParseError
+    from rotomorph.io.gcode_read import check_gcode
+
+    machines = ROOT / "examples" / "machines"
+    text = _program(load_machine_profile(machines / "linuxcnc.toml"), cure=0.0)
+    with pytest.raises(GcodeParseError, match=r"^line 6: the program was written for the 'rs274'"):
+        check_gcode(text, load_machine_profile(machines / "marlin.toml"))
+
+
+def test_checking_a_program_against_another_machine_of_its_dialect_names_both():
+    from rotomorph.errors import GcodeParseError
+    from rotomorph.io.gcode_read import check_gcode
+
+    machines = ROOT / "examples" / "machines"
+    text = _program(load_machine_profile(machines / "marlin.toml"), cure=0.0)
+    klipper = load_machine_profile(machines / "klipper.toml")
+    with pytest.raises(GcodeParseError) as err:
+        check_gcode(text, klipper)
+    assert str(err.value).startswith("line 20: unexpected command: 'M42 P4 S76' (the program ")
+    assert "header line 4: 'machine: Marlin rotational printer, profile marlin.toml'" in str(
+        err.value
+    )
+    assert str(err.value).endswith("the profile is 'Klipper rotational printer')")
+    check_gcode(text, load_machine_profile(machines / "marlin.toml"))  # its own profile: fine

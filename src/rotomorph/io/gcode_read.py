@@ -376,11 +376,36 @@ class _Reader:
 
     # ------------------------------------------------------------------ driver
     def run(self, text: str) -> GcodeReport:
-        m, s = self.m, self.s
+        """Read ``text``; a rotomorph program's header names the machine it was written for,
+        and an error on a program written for another machine says so."""
         lines = [ln.rstrip() for ln in text.splitlines()]
         first = 0  # first line that is not a comment
+        written: dict[str, tuple[int, str]] = {}
         while first < len(lines) and lines[first].startswith(";"):
+            found = re.match(r"; (dialect|machine): ([^,]+),", lines[first])
+            if found:
+                written[found[1]] = (first + 1, found[2])
             first += 1
+        dialect = written.get("dialect")
+        if dialect is not None and dialect[1] != self.m.dialect:
+            raise GcodeParseError(
+                f"line {dialect[0]}: the program was written for the {dialect[1]!r} dialect, the "
+                f"machine profile {self.m.name!r} is {self.m.dialect!r}; check it against the "
+                "profile it was written for (its '; machine:' header line)"
+            )
+        try:
+            return self._read(lines, first)
+        except GcodeParseError as err:
+            machine = written.get("machine")
+            if machine is None or lines[machine[0] - 1].startswith(f"; machine: {self.m.name}, "):
+                raise
+            raise GcodeParseError(
+                f"{err} (the program was written for another machine, header line "
+                f"{machine[0]}: {lines[machine[0] - 1][2:]!r}; the profile is {self.m.name!r})"
+            ) from None
+
+    def _read(self, lines: list[str], first: int) -> GcodeReport:
+        m, s = self.m, self.s
         i = first
         header = list(m.header_lines)
         for start in range(first, -1, -1):  # the header block may itself open with comments
