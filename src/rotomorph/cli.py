@@ -26,6 +26,7 @@ import argparse
 import contextlib
 import json
 import logging
+import math
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -306,6 +307,8 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     if out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
     _check_writable(out, create_parent=False)
+    if not (args.cure >= 0 and math.isfinite(args.cure)):
+        raise UsageError(f"--cure: must be a UV dwell in seconds >= 0; got {args.cure:g}")
     machine = _machine(args)
     programs = design.to_programs()
     _check_materials(programs)
@@ -340,6 +343,13 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     except InvalidParameterError as err:
         flag = "--" + err.field.replace("_", "-")
         raise UsageError(f"{flag}: {str(err).split(': ', 1)[1]}") from None
+    if args.spacing is not None:  # a filament too short (or a design too large) at that spacing
+        from rotomorph.io.designfile import with_spacing
+
+        try:
+            with_spacing(design, args.spacing)
+        except InvalidParameterError as err:
+            raise UsageError(f"--spacing: {err}") from None
     with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note(args):
         with _progress(step_count(design, args.steps), "simulate") as bar:
             sim = simulate_design(

@@ -46,7 +46,13 @@ def _write(tmp_path: Path, text: str) -> Path:
         (FILAMENT, ["--temperature", "1e12"], r"--temperature: must lie in [-50, 300] °C"),
         (FILAMENT, ["--temperature", "nan"], "--temperature: must be finite"),
         (FILAMENT, ["--steps", "0"], "--steps: must be a whole number in [1, 10000]"),
-        (FILAMENT, ["--spacing", "0"], "spacing: must be >= 0.001 mm"),
+        # before: "filaments[0].spacing: must be >= 0.001 mm" (a field the user did not write)
+        (FILAMENT, ["--spacing", "0"], "--spacing: must lie in [0.001, 100] mm; got 0.0"),
+        (FILAMENT, ["--spacing", "20"], "--spacing: filaments[0]: has 2 vertices at spacing 20"),
+        # before: "temperature: must exceed ..." (not the flag, raised while writing the run)
+        (FILAMENT, ["--temperature", "20"], "--temperature: must exceed the start temperature 25"),
+        (FILAMENT, ["--start-temperature", "200"], "--start-temperature: must be below the final"),
+        (LATTICE.format(n=3), ["--temperature", "20"], "--temperature: must exceed the start"),
     ],
 )
 def test_options_that_do_not_apply_or_are_absurd_are_refused(
@@ -92,3 +98,13 @@ def test_validate_checks_a_machine_like_gcode(tmp_path, capsys):
     machine.write_text('[machine]\nmax_feed = "50"\n')
     assert main(["validate", str(design), "--machine", str(machine)]) == EXIT_USAGE
     assert "max_feed" in _error(capsys)
+
+
+@pytest.mark.parametrize("cure", ["-5", "nan", "inf"])
+def test_gcode_cure_must_be_a_finite_dwell(tmp_path, capsys, cure):
+    # before: "layer_cure_s: must be >= 0 s; got nan" (a library argument, not the flag)
+    out = tmp_path / "x.gcode"
+    argv = ["gcode", str(_write(tmp_path, FILAMENT)), "-o", str(out), "--cure", cure]
+    assert main(argv) == EXIT_USAGE
+    assert _error(capsys) == f"--cure: must be a UV dwell in seconds >= 0; got {float(cure):g}"
+    assert not out.exists()

@@ -15,6 +15,8 @@ import math
 from typing import Any, Final
 
 from rotomorph.errors import InvalidParameterError
+from rotomorph.io.design_limits import LIMITS
+from rotomorph.materials.temperature import ACTUATION_TEMPERATURE, PRINT_TEMPERATURE
 
 __all__ = ["MAX_STEPS", "TEMPERATURE_ACTUATIONS", "TEMPERATURE_RANGE", "check_run_options"]
 
@@ -93,5 +95,23 @@ def check_run_options(
     for name, value in (("start_temperature", start_temperature), ("temperature", temperature)):
         if value is not None and not lo <= _number(name, value, "°C") <= hi:
             raise InvalidParameterError(name, f"must lie in [{lo:g}, {hi:g}] °C; got {value!r}")
+    start = PRINT_TEMPERATURE if start_temperature is None else start_temperature
+    end = ACTUATION_TEMPERATURE if temperature is None else temperature
+    if (start_temperature is not None or temperature is not None) and not start < end:
+        if temperature is not None:
+            raise InvalidParameterError(
+                "temperature",
+                f"must exceed the start temperature {start:g} °C (the ramp heats from it to "
+                f"this); got {end:g} °C",
+            )
+        raise InvalidParameterError(
+            "start_temperature",
+            f"must be below the final temperature {end:g} °C (the default; give a higher "
+            f"temperature to start this warm); got {start:g} °C",
+        )
     if spacing is not None:
-        _number("spacing", spacing, "mm")
+        limit = LIMITS["vertex_spacing"]
+        if not limit.minimum <= _number("spacing", spacing, "mm") <= limit.maximum:
+            raise InvalidParameterError(
+                "spacing", f"must lie in [{limit.minimum:g}, {limit.maximum:g}] mm; got {spacing!r}"
+            )
