@@ -108,3 +108,22 @@ def test_gcode_cure_must_be_a_finite_dwell(tmp_path, capsys, cure):
     assert main(argv) == EXIT_USAGE
     assert _error(capsys) == f"--cure: must be a UV dwell in seconds >= 0; got {float(cure):g}"
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message", "help_of"),
+    [
+        (
+            ["simulate", "d.toml", "-o", "x", "--steps", "abc"],
+            "argument --steps: invalid int value: 'abc'",
+            "rotomorph simulate",
+        ),
+        (["design", "d.toml"], "argument COMMAND: invalid choice: 'design'", "rotomorph"),
+    ],
+)
+def test_argument_errors_say_rotomorph_once_and_where_help_is(capsys, argv, message, help_of):
+    # before: "rotomorph: error: rotomorph simulate: argument --steps: ... (see --help)"
+    assert main(argv) == EXIT_USAGE
+    err = _error(capsys)
+    assert err.startswith(message), err
+    assert err.endswith(f"(see {help_of} --help)"), err
