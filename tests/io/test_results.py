@@ -237,3 +237,24 @@ def test_version_1_files_still_read(tmp_path, run):
         h5.attrs["format_version"] = 1
     res = read_results(path)
     assert res.static == {} and res.programs == () and res.n_steps == 4
+
+
+def test_summary_of_a_run_in_memory_gives_every_scalar_its_unit(run):
+    # before: summary.json of `rotomorph simulate` listed units only for the fields given
+    # explicitly (curvature, positions, ...), none for temperature, energy, lowest_eigenvalue
+    # or min_clearance, whose values it reports under initial / end_of_ramp
+    net, positions, scalars, fields, design = run
+    res = RunResults(
+        design=design,
+        edges=net.edges,
+        branch=net.branch,
+        positions=positions,
+        scalars={**scalars, "temperature": np.linspace(25.0, 175.0, 4)},
+        fields=fields,
+        units={"curvature_change": "1"},
+        metadata={},
+    )
+    units = summarize(res)["units"]
+    assert set(summarize(res)["end_of_ramp"]) <= set(units)
+    assert units["temperature"] == "degC" and units["energy"] == "N*mm"
+    assert units["positions"] == "mm" and units["curvature_change"] == "1"

@@ -452,12 +452,23 @@ def summarize(results: RunResults) -> dict[str, Any]:
         "n_edges": len(results.edges),
         "end_of_ramp": {k: to_jsonable(v[-1]) for k, v in results.scalars.items()},
         "initial": {k: to_jsonable(v[0]) for k, v in results.scalars.items()},
-        "units": dict(results.units),
+        "units": _summary_units(results),
         "metadata": meta,
     }
     if "filaments" in meta:
         out["filaments"] = meta["filaments"]
     return out
+
+
+def _summary_units(results: RunResults) -> dict[str, str]:
+    """Units of every array of ``results``, as :func:`write_results` stores them (the usual
+    scalars' units are defaults, so a run described in memory lists them too)."""
+    units = {"positions": "mm", **dict(results.units)}
+    for group in (results.scalars, results.fields, results.static):
+        for name in group:
+            if name not in units and name in DEFAULT_UNITS:
+                units[name] = DEFAULT_UNITS[name]
+    return units
 
 
 def write_summary(path: str | os.PathLike[str], summary: Mapping[str, Any]) -> Path:
