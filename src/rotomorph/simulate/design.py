@@ -388,7 +388,6 @@ def _simulate_lattice(
         "n": design.lattice.n,
         "steps": steps,
         "edge_mode": list(lattice.edge_mode),
-        "final": {k: float(v[-1]) for k, v in scalars.items()},
         "actuation_rule": res.actuation,
         "contact": surroundings_record(design.contact, hot, along_ramp=in_temperature),
         "assumptions": lattice_assumptions(lattice),
