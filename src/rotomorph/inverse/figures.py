@@ -37,7 +37,12 @@ def _filament(design: FilamentDesign, folder: Path) -> list[Path]:
     _equal_3d(ax, np.vstack([tgt, ach]))
     ax.legend(loc="upper left")
     fig.colorbar(sc, ax=ax, shrink=0.6, pad=0.12, label="distance to target (mm)")
-    ax.set_title(f"RMS error {design.rms_error:.3g} mm ({100 * design.rms_error_rel:.2g} % of L)")
+    unstable = design.stable is False  # the verifying equilibrium: flagged, not a result
+    ax.set_title(
+        f"RMS error {design.rms_error:.3g} mm ({100 * design.rms_error_rel:.2g} % of L)"
+        + ("\nNOT PHYSICAL: the simulated shape is not a stable minimum" if unstable else ""),
+        color="#b2182b" if unstable else "k",
+    )
     ax2 = fig.add_subplot(2, 2, 2)
     ax2.plot(s, design.speed, color="tab:blue")
     ax2.set_ylabel("print speed v (mm/s)")

@@ -91,6 +91,9 @@ class FilamentDesign:
         Number of active-side changes along the filament.
     notes
         Human-readable findings (unreachable stretches, flips spread by the rotation limit).
+    stable
+        Whether the verifying equilibrium is a certified stable minimum (``None`` without
+        verification).
     """
 
     program: PrintProgram
@@ -105,6 +108,7 @@ class FilamentDesign:
     rms_error_rel: float
     flips: int
     notes: list[str] = field(default_factory=list)
+    stable: bool | None = None
 
     @property
     def fully_reachable(self) -> bool:
@@ -304,10 +308,12 @@ def design_filament(
         notes.append(f"{int((~reachable).sum())} of {len(reachable)} vertices are not reachable")
     achieved = pts.copy()
     rms = float("nan")
+    stable: bool | None = None
     if verify:
         nat = natural_field(program, temperature=temperature, model=model)
         rod = Model.from_field(printed, nat)
         eq = solve_static(rod)
+        stable = eq.stable
         achieved = kabsch(eq.positions, pts)
         rms = float(np.sqrt(np.mean(np.sum((achieved - pts) ** 2, axis=1))))
     return FilamentDesign(
@@ -323,6 +329,7 @@ def design_filament(
         rms_error_rel=rms / geo.length,
         flips=len(flips_at),
         notes=notes,
+        stable=stable,
     )
 
 

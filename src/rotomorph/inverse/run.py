@@ -183,6 +183,7 @@ def run_inverse(
             "omega_star_range": [float(fil.omega_star.min()), float(fil.omega_star.max())],
             "notes": fil.notes,
             "verified_by": "forward simulation of the designed program (free filament)",
+            **_verified_state(fil, opt.radius),
         }
         return InverseRun(target, filament_design_file(fil, name), summary, [], fil)
     assert target.lattice is not None
@@ -239,6 +240,29 @@ def run_inverse(
     return InverseRun(target, design_file, summary, log, des)
 
 
+def _verified_state(fil: FilamentDesign, radius: float) -> dict[str, Any]:
+    """Whether the verifying equilibrium of a filament design is physical: a certified stable
+    minimum whose filament does not pass through itself (no contact is modelled)."""
+    from rotomorph.simulate.run_data import chain_clearance
+
+    clearance = float(chain_clearance(fil.achieved[None], 2.0 * radius)[0])
+    reasons = []
+    if fil.stable is False:
+        reasons.append("the verifying equilibrium is not a stable minimum")
+    if clearance < 1.0:
+        reasons.append(
+            f"the achieved shape passes through itself (clearance {clearance:.2f} diameters, "
+            "contact not modelled)"
+        )
+    verdict = "no" if reasons else ("unknown" if fil.stable is None else "yes")
+    reason = "; ".join(reasons) or ("stability not checked" if verdict == "unknown" else "")
+    return {
+        "stable": fil.stable,
+        "min_clearance_diameters": min(clearance, 2.0),
+        "physical": {"verdict": verdict, "reason": reason or "all checks passed"},
+    }
+
+
 def write_inverse(run: InverseRun, design_path: str | Path) -> list[Path]:
     """Write the design file and, in ``<design stem>_inverse/``, the summary, log and figures."""
     from rotomorph.inverse.figures import inverse_figures
@@ -274,9 +298,13 @@ def inverse_file(
     folder = Path(design_path).with_name(Path(design_path).stem + "_inverse")
     if target.kind == "curve":
         reach = "all reachable" if s["fully_reachable"] else "NOT all reachable (see summary)"
+        state = {"yes": "verified state physical", "unknown": "verified state unverified"}.get(
+            s["physical"]["verdict"], f"verified state NOT PHYSICAL: {s['physical']['reason']}"
+        )
         return (
             f"wrote {design_path} and {folder}/: RMS error {s['rms_error_mm']:.3g} mm "
-            f"({100 * s['rms_error_rel']:.2g} % of the length), {reach}, {s['flips']} flips"
+            f"({100 * s['rms_error_rel']:.2g} % of the length), {reach}, {s['flips']} flips; "
+            f"{state}"
         )
     k_t, k_a = s["target_gaussian_curvature"], s["achieved_gaussian_curvature"]
     kt = "" if k_t is None else f"target K {k_t:.3g} 1/mm², "

@@ -1,0 +1,46 @@
+"""A curve inverse design reports whether its verifying simulation is physical (stable, no
+self-overlap), in summary.json and on the command line, like every other simulated state."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from rotomorph.cli import main
+from rotomorph.inverse.run import _verified_state
+
+HELIX = (
+    'schema_version = 1\nkind = "curve"\n[curve]\nfamily = "helix"\n'
+    "radius_start = 2.0\nradius_end = 2.2\npitch = 1.5\nturns = 1.0\n"
+)
+
+
+def test_curve_summary_and_line_carry_the_verified_state(tmp_path, capsys):
+    # before: rms_error of the forward simulation without stable or clearance
+    target = tmp_path / "helix.toml"
+    target.write_text(HELIX, encoding="utf-8")
+    assert main(["inverse", str(target), "-o", str(tmp_path / "helix_design.toml")]) == 0
+    assert capsys.readouterr().out.rstrip().endswith("; verified state physical")
+    summary = json.loads((tmp_path / "helix_design_inverse" / "summary.json").read_text())
+    assert summary["stable"] is True
+    assert summary["min_clearance_diameters"] >= 1.0
+    assert summary["physical"] == {"verdict": "yes", "reason": "all checks passed"}
+
+
+class _Design:
+    """The two attributes the verdict reads (a FilamentDesign stand-in)."""
+
+    def __init__(self, achieved, stable):
+        self.achieved, self.stable = achieved, stable
+
+
+def test_an_overlapping_or_unstable_verified_shape_is_flagged():
+    t = np.linspace(0.0, 4 * np.pi, 400)  # two turns of a ring: passes through itself
+    ring = np.c_[3 * np.cos(t), 3 * np.sin(t), 0 * t]
+    state = _verified_state(_Design(ring, True), radius=0.3)
+    assert state["physical"]["verdict"] == "no"
+    assert "passes through itself" in state["physical"]["reason"]
+    line = np.c_[t, 0 * t, 0 * t]
+    assert _verified_state(_Design(line, False), 0.3)["physical"]["verdict"] == "no"
+    assert _verified_state(_Design(line, None), 0.3)["physical"]["verdict"] == "unknown"
