@@ -68,7 +68,12 @@ METRICS: tuple[Metric, ...] = (
     Metric("helix_turns", "1", "float", "filament", "turns of the fitted helix"),
     Metric("handedness", "1", "int", "filament", "+1 right, -1 left, 0 planar (fitted helix)"),
     Metric(
-        "closed_form_end_to_end_ratio", "1", "float", "filament", "L/L0 of the closed-form helix"
+        "closed_form_end_to_end_ratio",
+        "1",
+        "float",
+        "filament",
+        "L/L0 of the closed-form helix if infinitely long (axis advance per arc length; 0 for a "
+        "ring however short)",
     ),
     Metric("closed_form_morphology", "", "str", "filament", "label of the closed-form helix"),
     Metric(
