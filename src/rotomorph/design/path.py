@@ -26,7 +26,16 @@ import numpy as np
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidDesignError
 
-__all__ = ["Arc", "Line", "Path", "Polyline", "Segment", "Sinusoid", "chain_segments"]
+__all__ = [
+    "Arc",
+    "Line",
+    "Path",
+    "Polyline",
+    "Segment",
+    "Sinusoid",
+    "chain_segments",
+    "path_defect",
+]
 
 
 def _positive(field: str, value: float, unit: str) -> None:
@@ -120,15 +129,47 @@ def _check_points(points: FloatArray, field: str = "Path.points") -> FloatArray:
         raise InvalidDesignError(
             field, f"must be finite; vertex {int(np.flatnonzero(bad)[0])} is not"
         )
-    lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    defect = path_defect(pts)
+    if defect is not None:
+        raise InvalidDesignError(field, defect[1])
+    return pts
+
+
+#: Largest turn (deg) at one vertex: a sharper one retraces the edge just printed.
+MAX_TURN_DEG = 179.0
+
+
+def path_defect(points: FloatArray) -> tuple[int, str] | None:
+    """The first vertex at which a finite ``(N, 3)`` path cannot be printed, and why.
+
+    A repeated vertex (zero-length edge), or a turn sharper than :data:`MAX_TURN_DEG` (the
+    nozzle would go back over the filament it has just laid, and the tangent there is
+    undefined). ``None`` for a printable path.
+
+    Examples
+    --------
+    >>> path_defect(np.array([[0.0, 0, 0], [5, 0, 0], [0, 0, 0]]))[1][:50]
+    'turns back on itself at vertex 1 (a 180 deg turn):'
+    """
+    pts = np.asarray(points, dtype=float)
+    edges = np.diff(pts, axis=0)
+    lengths = np.linalg.norm(edges, axis=1)
     scale = max(1.0, float(np.abs(pts).max()))
     rep = lengths <= 1e-9 * scale
     if rep.any():
         i = int(np.flatnonzero(rep)[0])
-        raise InvalidDesignError(
-            field, f"vertices {i} and {i + 1} are repeated (zero-length edge); remove one"
+        return i, f"vertices {i} and {i + 1} are repeated (zero-length edge); remove one"
+    unit = edges / lengths[:, None]
+    cos = np.einsum("ij,ij->i", unit[:-1], unit[1:])
+    back = np.flatnonzero(cos < np.cos(np.radians(MAX_TURN_DEG)))
+    if len(back):
+        i = int(back[0]) + 1
+        turn = float(np.degrees(np.arccos(np.clip(cos[i - 1], -1.0, 1.0))))
+        return i, (
+            f"turns back on itself at vertex {i} (a {turn:.0f} deg turn): a filament cannot be "
+            "printed back over itself; offset the return by at least a filament diameter"
         )
-    return pts
+    return None
 
 
 def _count(length: float, spacing: float) -> int:

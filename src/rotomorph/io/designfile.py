@@ -63,7 +63,15 @@ from pydantic import (
 )
 
 from rotomorph.design.lattices import Lattice, sinusoidal_lattice
-from rotomorph.design.path import Arc, Line, Path, Polyline, Sinusoid, chain_segments
+from rotomorph.design.path import (
+    Arc,
+    Line,
+    Path,
+    Polyline,
+    Sinusoid,
+    chain_segments,
+    path_defect,
+)
 from rotomorph.design.program import PrintProgram, active_side_angle
 from rotomorph.errors import InvalidDesignError, MaterialError
 from rotomorph.io.atomic import atomic_write_text
@@ -343,6 +351,26 @@ class Filament(_Control, _Process):
                     )
         return self
 
+    @model_validator(mode="after")
+    def _printable_path(self) -> Filament:
+        # after _size: the path is built only for a design of a size that is accepted
+        try:
+            pts, owner = self._points()
+        except InvalidDesignError as err:  # e.g. a polyline that does not start at the end
+            raise ValueError(str(err)) from None
+        defect = path_defect(pts)
+        if defect is not None:
+            i, why = defect
+            raise ValueError(f"segments[{int(owner[i])}]: {why}")  # the edge leaving vertex i
+        return self
+
+    def _points(self) -> tuple[Any, Any]:
+        """Vertices ``(N, 3)`` (mm) of the chained segments and each vertex's segment."""
+        geo = [_geometry(s) for s in self.segments]
+        return chain_segments(
+            geo, start=self.start, heading=math.radians(self.heading_deg), spacing=self.spacing
+        )
+
     def to_program(self) -> PrintProgram:
         """The :class:`PrintProgram` of this filament.
 
@@ -350,10 +378,7 @@ class Filament(_Control, _Process):
         follows :math:`\\alpha_n = \\psi_v - \\alpha` (``interface_angle_deg``,
         ``active_side``); a segment without a control uses the filament's, else ω = 0.
         """
-        geo = [_geometry(s) for s in self.segments]
-        pts, owner = chain_segments(
-            geo, start=self.start, heading=math.radians(self.heading_deg), spacing=self.spacing
-        )
+        pts, owner = self._points()
         path = Path(pts)
         speed = np.array([self.segments[o].speed or self.speed for o in owner])
         kw: dict[str, Any] = dict(

@@ -1,0 +1,74 @@
+"""Print paths that no printer can lay down are refused when the design is read, naming the
+filament and the segment, instead of passing validation and failing later (NaN tangents, an
+internal 'Model.rest_length' error in simulate, G-code that prints over its own filament)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rotomorph.cli import EXIT_USAGE, main
+from rotomorph.design.path import Path, path_defect
+from rotomorph.errors import InvalidDesignError
+from rotomorph.io.designfile import parse_design
+
+
+def _design(*segments):
+    fil = {"spacing": 0.5, "segments": list(segments)}
+    return {"schema_version": 1, "filaments": [{"spacing": 0.5, "segments": [LINE]}, fil]}
+
+
+LINE = {"kind": "line", "length": 5.0}
+
+
+@pytest.mark.parametrize(
+    ("segments", "message"),
+    [
+        (
+            [{"kind": "polyline", "points": [[0, 0, 0], [5, 0, 0], [0, 0, 0]]}],
+            "filaments[1]: segments[0]: turns back on itself at vertex 1 (a 180 deg turn)",
+        ),
+        (
+            [{"kind": "polyline", "points": [[0, 0, 0], [5, 0, 0], [0, 1e-4, 0]]}],
+            "filaments[1]: segments[0]: turns back on itself at vertex 1",
+        ),
+        (
+            [LINE, {"kind": "polyline", "points": [[5, 0, 0], [1, 0, 0]]}],
+            "filaments[1]: segments[1]: turns back on itself at vertex 10",
+        ),
+        (
+            [{"kind": "polyline", "points": [[0, 0, 0], [0, 0, 0], [5, 0, 0]]}],
+            "filaments[1]: segments[0]: vertices 0 and 1 are repeated",
+        ),
+        (  # before: "segments[1].points: ..." without the filament
+            [LINE, {"kind": "polyline", "points": [[6, 0, 0], [9, 0, 0]]}],
+            "filaments[1]: segments[1].points: must start at the current end",
+        ),
+    ],
+)
+def test_unprintable_paths_name_filament_and_segment(segments, message):
+    with pytest.raises(InvalidDesignError) as err:
+        parse_design(_design(*segments))
+    assert message in str(err.value)
+
+
+def test_turns_up_to_the_limit_are_printable():
+    square = [[0, 0, 0], [5, 0, 0], [5, 5, 0], [0, 5, 0]]  # 90 deg corners
+    hairpin = [[0, 0, 0], [5, 0, 0], [0, 0.2, 0]]  # a 177.7 deg turn
+    for points in (square, hairpin):
+        parse_design(_design({"kind": "polyline", "points": points}))
+    assert path_defect(np.array(hairpin, dtype=float)) is None
+    with pytest.raises(InvalidDesignError, match=r"Path\.points: turns back on itself"):
+        Path(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 0]]))
+
+
+def test_simulate_refuses_a_retracing_path_before_computing(tmp_path, capsys):
+    design = tmp_path / "back.toml"
+    design.write_text(
+        "schema_version = 1\n[[filaments]]\nspacing = 0.5\n"
+        'segments = [{ kind = "polyline", points = [[0,0,0],[5,0,0],[0,0,0]] }]\n'
+    )
+    assert main(["simulate", str(design), "-o", str(tmp_path / "run")]) == EXIT_USAGE
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rotomorph: error: filaments[0]: segments[0]: turns back on itself")
+    assert not (tmp_path / "run").exists()
