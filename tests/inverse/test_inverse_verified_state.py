@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from rotomorph.cli import main
 from rotomorph.inverse.run import _verified_state
@@ -44,3 +45,27 @@ def test_an_overlapping_or_unstable_verified_shape_is_flagged():
     line = np.c_[t, 0 * t, 0 * t]
     assert _verified_state(_Design(line, False), 0.3)["physical"]["verdict"] == "no"
     assert _verified_state(_Design(line, None), 0.3)["physical"]["verdict"] == "unknown"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (  # before: "options.spacng: Extra inputs are not permitted"
+            HELIX + "[options]\nspacng = 0.1\n",
+            "options.spacng: unknown key; remove it or check its spelling",
+        ),
+        (  # before: "kind: Field required"
+            'schema_version = 1\n[[filaments]]\nsegments = [{kind = "line", length = 5.0}]\n',
+            "kind: is required: this looks like a design file",
+        ),
+        (
+            'schema_version = 1\n[curve]\nfamily = "helix"\n',
+            "kind: is required; add kind = 'curve', 'dome', 'saddle' or 'height_map'",
+        ),
+    ],
+)
+def test_target_file_mistakes_say_what_to_do(tmp_path, capsys, text, message):
+    target = tmp_path / "target.toml"
+    target.write_text(text, encoding="utf-8")
+    assert main(["inverse", str(target), "-o", str(tmp_path / "d.toml")]) == 2
+    assert capsys.readouterr().err.strip().startswith(f"rotomorph: error: {message}")

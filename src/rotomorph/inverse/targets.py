@@ -238,6 +238,12 @@ def _rotate(vectors: FloatArray, axis: FloatArray, angle: float) -> FloatArray:
 
 def _format(err: Any) -> tuple[str, str]:
     loc = ".".join(str(p) for p in err["loc"]) or "<target>"
+    if err["type"] == "extra_forbidden":  # as the design and sweep files say it
+        return loc, "unknown key; remove it or check its spelling (see docs/inverse.md)"
+    if err["type"] == "missing" and loc == "kind":
+        return loc, "is required; add kind = 'curve', 'dome', 'saddle' or 'height_map'"
+    if err["type"] == "missing":
+        return loc, "is required"
     return loc, err["msg"].removeprefix("Value error, ")
 
 
@@ -245,6 +251,13 @@ def parse_target(data: dict[str, Any]) -> TargetFile:
     """Validate a mapping (parsed TOML) into a :class:`TargetFile`."""
     if "schema_version" not in data:
         raise InvalidDesignError("schema_version", "is required; add schema_version = 1")
+    if "kind" not in data and ("filaments" in data or "lattice" in data):
+        raise InvalidDesignError(
+            "kind",
+            "is required: this looks like a design file ([[filaments]] / [lattice]), not a "
+            "target; give a target file with kind = 'curve', 'dome', 'saddle' or 'height_map' "
+            "(examples/targets/)",
+        )
     try:
         return TargetFile.model_validate(data)
     except ValidationError as exc:
