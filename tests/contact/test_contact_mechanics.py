@@ -99,6 +99,22 @@ def test_filament_rests_on_floor_with_reaction_equal_to_buoyant_weight():
     assert np.allclose(res.positions[:, :2].mean(0), pts[:, :2].mean(0), atol=1e-9)
 
 
+def test_contracting_filament_keeps_its_printed_weight():
+    """Mass is conserved: a filament whose natural rest length shrinks by 30 % (an LCE
+    contracting) still presses on the floor with the weight of what was printed."""
+    model, pts = _filament(1.2 * R)
+    shrunk = model.with_natural(rest_length=0.7 * np.asarray(model.rest_length))
+    gravity = Gravity(density=1.2, area=np.pi * R**2, fluid_density=0.97)
+    res = solve_static(shrunk, loads=Loads(gravity=gravity), contact=Contact(R, (Floor(),)))
+    printed = float(
+        (gravity.line_weight(len(pts) - 1) * np.linalg.norm(np.diff(pts, axis=0), axis=1)).sum()
+    )
+    reaction = res.contact.forces(res.positions).sum(axis=0)
+    # (the shrunk rod carries an axial force: force balance to the solve tolerance, 1e-4; the
+    # weight of the natural rest length would be 30 % short)
+    assert reaction[2] == pytest.approx(printed, rel=1e-4)
+
+
 def test_free_body_without_floor_under_gravity_is_refused():
     model, _ = _filament(1.2 * R)
     gravity = Gravity(density=1.2, area=np.pi * R**2, fluid_density=0.97)

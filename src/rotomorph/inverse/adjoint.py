@@ -156,23 +156,9 @@ def adjoint(
         lam_free = lam_free + lu.solve(r)
     lam = np.zeros(model.layout.count)
     lam[obj.free] = lam_free
-    sens = natural_sensitivity(model, state, lam)
-    if loads.gravity is not None:
-        sens.rest_length = sens.rest_length + _gravity_products(model, loads, lam)
-    return AdjointResult(adjoint=lam, sensitivity=sens)
-
-
-def _gravity_products(model: Model, loads: Loads, lam: FloatArray) -> FloatArray:
-    """``lambda^T dg/dl_j`` of the self-weight: each edge's weight ``w_j l_j`` (N) acts half
-    on each end node, so ``dg/dl_j = -w_j d / 2`` on both (``d`` the unit direction)."""
-    assert loads.gravity is not None
-    net, lay = model.network, model.layout
-    w = loads.gravity.line_weight(net.n_edges)
-    d = np.asarray(loads.gravity.direction, float)
-    d = d / np.linalg.norm(d)
-    lam_pos = lam[lay.pos[:, None] + np.arange(3)]  # (N, 3)
-    ends = lam_pos[net.edges[:, 0]] + lam_pos[net.edges[:, 1]]
-    return np.asarray(-0.5 * w * (ends @ d))
+    # the self-weight is that of the printed filament (printed lengths), so it does not
+    # depend on the natural field: no term of its own here
+    return AdjointResult(adjoint=lam, sensitivity=natural_sensitivity(model, state, lam))
 
 
 def richardson_difference(fun: Callable[[float], float], step: float) -> float:

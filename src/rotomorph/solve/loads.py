@@ -47,12 +47,16 @@ class Supports:
 class Gravity:
     """Self-weight of the filaments, lumped to the nodes.
 
+    The mass is what was printed: each edge weighs ``line_weight`` times its printed length
+    (the network's edge length), so a filament whose actuation shortens its natural rest
+    length (a contracting LCE) keeps its weight, its section thickening as it shortens.
+
     Parameters
     ----------
     density
         Filament density (g/cm³).
     area
-        Cross-section area (mm²); scalar or per edge.
+        Cross-section area as printed (mm²); scalar or per edge.
     fluid_density
         Density of the surrounding fluid (g/cm³), for buoyancy (silicone oil ≈ 0.97).
     acceleration

@@ -168,7 +168,9 @@ class RodObjective:
             vec = _vector("Loads.forces", force)
             f[lay.pos[node] + np.arange(3)] += vec
         if loads.gravity is not None:
-            w = loads.gravity.line_weight(net.n_edges) * cast(FloatArray, self.model.rest_length)
+            # mass is what was printed: the weight per printed length times the printed length
+            # (the network's), whatever the natural rest length the actuation gives the edge
+            w = loads.gravity.line_weight(net.n_edges) * net.edge_lengths
             d = np.asarray(loads.gravity.direction, float)
             d = d / np.linalg.norm(d)
             for end in (0, 1):
