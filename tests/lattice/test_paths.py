@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import time
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -14,6 +17,7 @@ from rotomorph.lattice.paths import (
     PathCheck,
     check_factor,
     choose_end,
+    per_row,
     shape_distance,
     sub_stepped,
 )
@@ -74,6 +78,19 @@ def _small():
     return sinusoidal_lattice(3, 5.0, 1.25, 6, "dome")
 
 
+def test_rows_take_the_most_halvings_and_the_summed_time_of_their_sub_steps():
+    steps = [
+        SimpleNamespace(halvings=h, wall_time=t)
+        for h, t in [(0, 1.0), (2, 0.5), (1, 0.25), (0, 2.0)]
+    ]
+    halvings, wall = per_row(steps, 2)
+    assert list(halvings) == [0, 2, 1]
+    np.testing.assert_allclose(wall, [0.0, 1.5, 2.25])
+    halvings, wall = per_row(steps, 1)
+    assert list(halvings) == [0, 0, 2, 1, 0]
+    np.testing.assert_allclose(wall, [0.0, 1.0, 0.5, 0.25, 2.0])
+
+
 def test_path_check_records_both_ramps():
     plain = heat_lattice(_small(), steps=2)
     res = heat_lattice(_small(), steps=2, path_check=2)
@@ -114,6 +131,7 @@ def test_a_failed_second_ramp_keeps_the_first(monkeypatch):
     def second_fails(*args, **kwargs):  # type: ignore[no-untyped-def]
         calls.append(1)
         if len(calls) == 2:
+            time.sleep(0.05)  # what the failed ramp cost before it failed
             raise ConvergenceError("injected")
         return real(*args, **kwargs)
 
@@ -122,6 +140,7 @@ def test_a_failed_second_ramp_keeps_the_first(monkeypatch):
     res = heat_lattice(_small(), steps=2, path_check=2)
     assert res.path_check is not None and res.path_check.kept == "steps"
     assert "failed" in res.path_check.note
+    assert res.path_check.discarded_wall_time >= 0.05  # the failed ramp's time is recorded
     np.testing.assert_array_equal(res.iterations, plain.iterations)
     np.testing.assert_allclose(res.positions, plain.positions, atol=1e-12)
 

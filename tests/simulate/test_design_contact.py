@@ -61,8 +61,34 @@ def test_on_the_floor_under_buoyant_weight():
     assert sim.positions[-1, :, 2].max() < floor + 4 * r  # weighed down: stays near the floor
     record = run.metadata["contact"]
     assert record["gravity"] and 0.8 < record["bath_density_g_cm3"] < 0.97  # hot oil, lighter
-    assert record["bath_density_along_ramp"] is False  # a filament: the end temperature
+    assert record["bath_density_along_ramp"] is True  # weighed in the bath of each step
     assert "PDMS" in record["bath_density_assumption"] or record["bath_density_source"]
+
+
+def test_a_filament_is_weighed_in_the_bath_of_each_ramp_step():
+    """The buoyant weight follows the bath's density over the ramp: every step is solved with
+    the loads of its own temperature (the oil is lighter hot, the net weight larger)."""
+    from rotomorph.materials.bath import bath_density
+    from rotomorph.simulate.filament import simulate_filament
+    from rotomorph.simulate.surroundings import filament_surroundings
+
+    design = parse_design({**RING, "contact": {"floor": True, "gravity": True}})
+    fil = design.filaments[0]
+    program = fil.to_program()
+    contact, loads = filament_surroundings(design.contact, program, fil)
+    assert loads is not None
+    cold, hot = loads(25.0).gravity, loads(175.0).gravity
+    assert cold is not None and hot is not None
+    assert cold.fluid_density == pytest.approx(bath_density("silicone_oil", 25.0))
+    assert hot.line_weight(1)[0] > 1.5 * cold.line_weight(1)[0]
+    asked: list[float] = []
+
+    def recorded(temperature: float):  # type: ignore[no-untyped-def]
+        asked.append(temperature)
+        return loads(temperature)
+
+    sim = simulate_filament(program, steps=3, contact=contact, loads=recorded)
+    np.testing.assert_allclose(sorted(set(asked)), sim.temperature[1:], rtol=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -22,6 +22,7 @@ under its weight takes a lifted equilibrium where one is lower in energy (``bran
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
@@ -50,6 +51,7 @@ from rotomorph.lattice.paths import (
     PathCheck,
     check_factor,
     choose_end,
+    per_row,
     shape_distance,
     sub_stepped,
 )
@@ -568,12 +570,14 @@ def heat_lattice(
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
 
     probes: dict[float, float] = {}  # parameter -> energy of the lifted branch minus resting
+    announced: list[bool] = []  # the set-up line is logged once, not again for a path check
 
     def solve(p: float, state: State) -> StaticResult:
         phase_log.info("natural field (%s) at %g", act.name, p)
         model = act.natural(lm, p)
-        if not events:
+        if not announced:
             phase_log.info("set-up: Hessian sparsity pattern and ordering; then Newton solves")
+            announced.append(True)
         try:
             loads = loads_at(p)
             res = solve_static(model, sup, loads, initial=state, options=options, contact=settings)
@@ -606,6 +610,7 @@ def heat_lattice(
         events.clear()
         probes.clear()
         fine: ContinuationResult | None
+        started = time.perf_counter()
         try:
             fine = continuation(
                 solve,
@@ -616,6 +621,7 @@ def heat_lattice(
             )
         except (ConvergenceError, InfeasibleContactError):
             fine = None
+        fine_wall = time.perf_counter() - started  # also what a failed ramp cost
         same = fine is not None and shape_distance(
             path.final.positions, fine.final.positions
         ) <= SAME_SHAPE_TOL * float(lattice.radius)
@@ -628,22 +634,19 @@ def heat_lattice(
             same,
             factor,
         )
-        dropped: ContinuationResult | None
         if checked.kept == "sub-steps":
             assert fine is not None
-            dropped_events, dropped = first_events, path
+            dropped_events, dropped_wall = first_events, sum(st.wall_time for st in path.steps)
             finals, path = fine.results[factor - 1 :: factor], fine
         else:
-            dropped_events, dropped = list(events), fine
+            dropped_events, dropped_wall = list(events), fine_wall
             events[:] = first_events
             probes.clear()
             probes.update(first_probes)
         checked = replace(
             checked,
             discarded_iterations=sum(e[1] for e in dropped_events),
-            discarded_wall_time=0.0
-            if dropped is None
-            else sum(st.wall_time for st in dropped.steps),
+            discarded_wall_time=dropped_wall,
         )
     per_step = factor if len(path.steps) > len(finals) else 1  # sub-steps per kept row
     brackets: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)
@@ -674,9 +677,7 @@ def heat_lattice(
         iterations[k] += its
         if ok and k < len(values) and p == values[k]:
             k += 1
-    groups = [path.steps[i : i + per_step] for i in range(0, len(path.steps), per_step)]
-    halvings = np.array([0] + [max(s.halvings for s in g) for g in groups], dtype=np.int64)
-    wall = np.array([0.0] + [sum(s.wall_time for s in g) for g in groups])
+    halvings, wall = per_row(path.steps, per_step)
     fused = fused_pairs(ref, lattice.network.edges, 2.0 * lattice.radius)
     rows = [_measure(lattice, p, ref, loop, fused) for p in positions]
     ratios = np.stack([r[3] for r in rows])

@@ -12,11 +12,13 @@ applied to the path.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 
 __all__ = [
@@ -24,6 +26,7 @@ __all__ = [
     "PathCheck",
     "check_factor",
     "choose_end",
+    "per_row",
     "shape_distance",
     "sub_stepped",
 ]
@@ -132,3 +135,14 @@ def choose_end(
     same = bool(np.isfinite(e2) and same_shape)
     second = not same and s2 and (not s1 or e2 < e1)
     return PathCheck(factor, (e1, e2), (s1, s2), "sub-steps" if second else "steps", same)
+
+
+def per_row(steps: Sequence[Any], per_step: int) -> tuple[IntArray, FloatArray]:
+    """Halvings and wall time (s) of each reported row from the continuation's ``steps``
+    (each with ``halvings`` and ``wall_time``), ``per_step`` consecutive (sub-)steps per row:
+    a row's halvings are the most any of its sub-steps needed, its time their sum. Row 0 (the
+    printed state) is 0."""
+    groups = [steps[i : i + per_step] for i in range(0, len(steps), per_step)]
+    halvings = np.array([0] + [max(s.halvings for s in g) for g in groups], dtype=np.int64)
+    wall = np.array([0.0] + [sum(s.wall_time for s in g) for g in groups])
+    return halvings, wall

@@ -179,7 +179,7 @@ def _simulate_filaments(
             steps,
         )
         program = fil.to_program()
-        contact, loads = filament_surroundings(design.contact, program, fil, temperature)
+        contact, loads = filament_surroundings(design.contact, program, fil)
         sims.append(
             simulate_filament(
                 program,
@@ -196,7 +196,7 @@ def _simulate_filaments(
     sim = filaments_simulation(
         sims, design.model_dump(mode="json"), temperatures=(start_temperature, temperature)
     )
-    record = surroundings_record(design.contact, temperature)
+    record = surroundings_record(design.contact, temperature, along_ramp=True)
     if record is None:
         return sim
     return replace(sim, metadata={**sim.metadata, "contact": record})

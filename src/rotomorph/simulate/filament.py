@@ -263,7 +263,7 @@ def simulate_filament(
     max_refinements: int = 4,
     progress: Progress | None = None,
     contact: Contact | None = None,
-    loads: Loads | None = None,
+    loads: Loads | Callable[[float], Loads] | None = None,
 ) -> FilamentSimulation:
     """Equilibrium shapes of a free filament heated from ``start_temperature`` to ``temperature``.
 
@@ -290,7 +290,8 @@ def simulate_filament(
         tight coils touch instead of passing through themselves.
     loads
         Dead loads (:class:`rotomorph.solve.loads.Loads`), e.g. the buoyant weight of a
-        filament resting on a floor obstacle.
+        filament resting on a floor obstacle; or a function of the temperature (°C) returning
+        them, for loads that change along the ramp (the bath's density falls as it heats).
 
     Raises
     ------
@@ -327,9 +328,12 @@ def simulate_filament(
         # field): only the halved sub-steps use a blend, every reported step is exact
         k = min(int(np.floor(w)), s - 2)
         field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
+        # loads of the step's temperature (a halved step's linear blend)
+        t_w = float(temps[k] + (w - k) * (temps[k + 1] - temps[k]))
+        step_loads = loads(t_w) if callable(loads) else loads
         res = solve_static(
             rod_model(program, field),
-            loads=loads,
+            loads=step_loads,
             initial=initial,
             options=options,
             contact=contact,

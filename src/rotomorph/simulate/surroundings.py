@@ -4,13 +4,15 @@ and the buoyant weight, plus the record of those choices for the run's outputs.
 The floor lies just below the printed structure (:meth:`rotomorph.contact.Floor.under`: the
 lowest centre line 1.005 r above it, as a filament printed on the substrate rests); the
 buoyant line weight is (ρ_filament − ρ_bath) g A with ρ_filament the inks' densities
-weighted by the section's active share, and ρ_bath the bath fluid's density at the run's final
-temperature
-(:func:`rotomorph.materials.bath.bath_density`, data and source in the bath-fluid table).
+weighted by the section's active share, and ρ_bath the bath fluid's density at every
+temperature of the heating ramp (:func:`rotomorph.materials.bath.bath_density`, data and source
+in the bath-fluid table): the hot oil is lighter, so the net weight grows as the bath heats.
+The weight is that of the printed filament (:class:`rotomorph.solve.loads.Gravity`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -31,9 +33,10 @@ def _density(active: str, passive: str, active_fraction: float) -> float:
 
 
 def filament_surroundings(
-    contact: Any, program: Any, filament: Any, temperature: float
-) -> tuple[Contact | None, Loads | None]:
-    """Contact settings and loads of one filament (``None, None`` without ``[contact]``).
+    contact: Any, program: Any, filament: Any
+) -> tuple[Contact | None, Callable[[float], Loads] | None]:
+    """Contact settings of one filament and its loads as a function of the bath temperature
+    (°C) (``None, None`` without ``[contact]``; loads ``None`` without gravity).
 
     Parameters
     ----------
@@ -43,8 +46,6 @@ def filament_surroundings(
         The filament's print program (vertices, radius).
     filament
         The filament's design entry (materials, active fraction).
-    temperature
-        Final temperature of the run (°C): the bath density is taken there.
     """
     if contact is None:
         return None, None
@@ -56,17 +57,17 @@ def filament_surroundings(
         self_contact=contact.self_contact,
         friction=contact.friction,
     )
-    loads = None
-    if contact.gravity:
-        density = _density(
-            filament.active_material, filament.passive_material, filament.active_fraction
-        )
-        gravity = Gravity(
-            density=density,
-            area=np.pi * radius**2,
-            fluid_density=bath_density(contact.bath, temperature),
-        )
-        loads = Loads(gravity=gravity)
+    if not contact.gravity:
+        return settings, None
+    density = _density(
+        filament.active_material, filament.passive_material, filament.active_fraction
+    )
+    area, bath = np.pi * radius**2, str(contact.bath)
+
+    def loads(temperature: float) -> Loads:
+        fluid = bath_density(bath, temperature)
+        return Loads(gravity=Gravity(density=density, area=area, fluid_density=fluid))
+
     return settings, loads
 
 
