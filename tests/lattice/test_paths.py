@@ -53,6 +53,13 @@ def test_choose_end():
     assert unstable.kept == "steps" and "sub-stepped one is not certified stable" in unstable.note
     only = choose_end((0.1, 0.3), (False, True), False, 2)  # only the second end is stable
     assert only.kept == "sub-steps" and "requested one is not certified stable" in only.note
+    # different shapes of equal energy (a flat valley, a symmetric partner): a tie, never a
+    # switch on round-off, whichever end is lower by it
+    for e2 in (0.19591544551155562, 0.19591544551154):
+        tie = choose_end((0.19591544551155, e2), (True, True), False, 2)
+        assert tie.tie and tie.kept == "steps" and not tie.same_state
+        assert "same total energy" in tie.note
+    assert not choose_end((0.2, 0.2 * (1 - 1e-8)), (True, True), False, 2).tie
     failed = choose_end((0.3, np.nan), (True, False), False, 2)
     assert failed.kept == "steps" and "failed" in failed.note
 

@@ -22,6 +22,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 
 __all__ = [
+    "ENERGY_TIE",
     "SAME_SHAPE_TOL",
     "PathCheck",
     "check_factor",
@@ -34,6 +35,10 @@ __all__ = [
 #: Largest node distance (in filament radii), after the best rigid alignment, below which two
 #: end states count as the same state (free lattices drift rigidly by round-off).
 SAME_SHAPE_TOL = 1e-3
+#: Relative difference of total energy below which two end states of different shape are a
+#: tie: one flat valley of the energy (a soft mode the solver's tolerance leaves undetermined)
+#: or symmetric partners, never a reason to prefer one (round-off is ~1e-14 here).
+ENERGY_TIE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -54,6 +59,9 @@ class PathCheck:
         at the requested parameters).
     same_state
         Both ramps ended in the same state (:data:`SAME_SHAPE_TOL`).
+    tie
+        The ends differ in shape but not in total energy (:data:`ENERGY_TIE`): the ramp as
+        requested is kept.
     discarded_iterations, discarded_wall_time
         Newton iterations and seconds of the ramp not kept (not in the result's
         ``iterations`` and ``wall_time``).
@@ -66,6 +74,7 @@ class PathCheck:
     same_state: bool
     discarded_iterations: int = 0
     discarded_wall_time: float = 0.0
+    tie: bool = False
 
     @property
     def note(self) -> str:
@@ -76,6 +85,12 @@ class PathCheck:
             return f"path check: {second} failed; the ramp as requested is kept"
         if self.same_state:
             return f"path check: {second} ends in the same state"
+        if self.tie:
+            return (
+                f"path check: {second} ends in another shape of the same total energy "
+                f"({e1:.9g} and {e2:.9g} N mm: one flat valley of the energy or a symmetric "
+                "partner, not a lower state); the ramp as requested is kept"
+            )
         ends = (
             f"path check: the ramp as requested and {second} end in different states "
             f"(total energy {e1:.6g} and {e2:.6g} N mm"
@@ -128,13 +143,18 @@ def choose_end(
     energy: tuple[float, float], stable: tuple[bool, bool], same_shape: bool, factor: int
 ) -> PathCheck:
     """Which ramp to keep: the requested one unless the sub-stepped one ends in a different
-    state that is certified stable and either lower in total energy or the only stable one.
-    ``energy`` holds both final total energies (NaN for a failed ramp)."""
+    state that is certified stable and either lower in total energy (by more than
+    :data:`ENERGY_TIE`) or the only stable one. ``energy`` holds both final total energies
+    (NaN for a failed ramp)."""
     e1, e2 = (float(e) for e in energy)
     s1, s2 = bool(stable[0]), bool(stable[1]) and np.isfinite(e2)
     same = bool(np.isfinite(e2) and same_shape)
-    second = not same and s2 and (not s1 or e2 < e1)
-    return PathCheck(factor, (e1, e2), (s1, s2), "sub-steps" if second else "steps", same)
+    tie = bool(
+        not same and s1 and s2 and abs(e1 - e2) <= ENERGY_TIE * max(abs(e1), abs(e2), 1e-300)
+    )
+    second = not same and not tie and s2 and (not s1 or e2 < e1)
+    kept = "sub-steps" if second else "steps"
+    return PathCheck(factor, (e1, e2), (s1, s2), kept, same, tie=tie)
 
 
 def per_row(steps: Sequence[Any], per_step: int) -> tuple[IntArray, FloatArray]:
