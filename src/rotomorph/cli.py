@@ -180,11 +180,12 @@ def _load_design(path: str) -> Any:
 
 
 @contextlib.contextmanager
-def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
+def _output_folder(path: str, *, force: bool, inputs: Sequence[Path] = ()) -> Iterator[Path]:
     """Yield a temporary folder next to ``path``; swap it onto ``path`` on success.
 
     On error (or SIGTERM) the temporary folder is removed and ``path`` is untouched
-    (:func:`rotomorph.io.atomic.atomic_folder`).
+    (:func:`rotomorph.io.atomic.atomic_folder`). A folder that holds the current folder or one
+    of the ``inputs`` (the design file) is never replaced, ``--force`` or not.
     """
     from rotomorph.io.atomic import atomic_folder
 
@@ -193,6 +194,19 @@ def _output_folder(path: str, *, force: bool) -> Iterator[Path]:
     target = Path(path)
     if target.exists() and not target.is_dir():
         raise UsageError(f"-o/--output: {path}: exists and is not a folder")
+    if target.is_dir():
+        here = target.resolve()
+        if Path.cwd().resolve().is_relative_to(here):
+            raise UsageError(
+                f"-o/--output: {path}: is the current folder or holds it; replacing it would "
+                "delete what is in it: give a new folder"
+            )
+        for item in inputs:
+            if item.resolve().is_relative_to(here):
+                raise UsageError(
+                    f"-o/--output: {path}: holds the input {item}; replacing it would delete "
+                    "it: give a new folder"
+                )
     if target.is_dir() and any(target.iterdir()) and not force:
         raise UsageError(f"-o/--output: {path}: folder is not empty; use --force to replace it")
     _check_writable(target, create_parent=True)
@@ -350,7 +364,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             with_spacing(design, args.spacing)
         except InvalidParameterError as err:
             raise UsageError(f"--spacing: {err}") from None
-    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note(args):
+    output = _output_folder(args.output, force=args.force, inputs=[Path(args.design)])
+    with output as tmp, _phases(), _compiling_note(args):
         with _progress(step_count(design, args.steps), "simulate") as bar:
             sim = simulate_design(
                 design,

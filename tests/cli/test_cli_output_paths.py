@@ -93,3 +93,39 @@ def test_check_writable_creates_missing_parents_only_when_asked(tmp_path):
     assert not (tmp_path / "a").exists()
     assert check_writable(deep, "-o", create_parent=True) == deep.parent
     assert deep.parent.is_dir() and list(deep.parent.iterdir()) == []  # the probe is gone
+
+
+def test_force_never_replaces_the_folder_holding_the_design(tmp_path, capsys):
+    # before: `simulate runs/design.toml -o runs --force` computed, then deleted the design
+    # file and everything else in runs/
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    design = runs / "design.toml"
+    design.write_text(DESIGN)
+    (runs / "notes.txt").write_text("mine")
+    argv = ["simulate", str(design), "-o", str(runs), "--force", "--steps", "1"]
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"rotomorph: error: -o/--output: {runs}: holds the input {design}; replacing it would "
+        "delete it: give a new folder"
+    )
+    assert sorted(p.name for p in runs.iterdir()) == ["design.toml", "notes.txt"]
+
+
+@pytest.mark.parametrize("command", ["simulate", "paper"])
+def test_force_never_replaces_the_current_folder(tmp_path, capsys, monkeypatch, command):
+    # before: `-o . --force` computed the whole run, then failed with ".: Device or resource
+    # busy"; `-o .. --force` would have replaced the parent of the current folder
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "design.toml").write_text(DESIGN)
+    monkeypatch.chdir(work)
+    for out in (".", str(tmp_path)):
+        argv = [command, *(["design.toml"] if command == "simulate" else []), "-o", out]
+        assert main([*argv, "--force"]) == EXIT_USAGE
+        err = capsys.readouterr().err.strip()
+        assert err.endswith(": is the current folder or holds it; replacing it would delete "
+                            "what is in it: give a new folder"), err  # fmt: skip
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["work"]
+    assert [p.name for p in work.iterdir()] == ["design.toml"]
