@@ -147,6 +147,46 @@ def test_an_unleavable_saddle_is_reported_not_converged():
     assert res.status is Status.SADDLE and not res.converged
 
 
+class _MaskedSaddle(FunctionObjective):
+    """f = x^2/2 - eps y^2/2 + y^4/4 with the convex approximation diag(1, 1): the exact
+    Hessian is indefinite near y = 0, and whole steps on the convex one grow y only by a
+    factor 1 + eps per iteration (the iterate creeps off the saddle, the residual growing)."""
+
+    eps = 0.05
+
+    def __init__(self) -> None:
+        e = self.eps
+        super().__init__(
+            lambda v: 0.5 * v[0] ** 2 - 0.5 * e * v[1] ** 2 + 0.25 * v[1] ** 4,
+            lambda v: np.array([v[0], -e * v[1] + v[1] ** 3]),
+            lambda v: np.diag([1.0, -e + 3 * v[1] ** 2]),
+            energy_scale=1e-12,
+        )
+        self.has_convex_hessian = True
+
+    def evaluate(self, x, need_grad, need_hess):  # type: ignore[no-untyped-def]
+        f, g, h = super().evaluate(x, need_grad, need_hess)
+        return f, g, (np.eye(2) if need_hess == 2 else h)
+
+    def convex_hessian(self, x):  # type: ignore[no-untyped-def]
+        return np.eye(2)
+
+
+def test_creeping_off_a_masked_saddle_is_extended():
+    # from y = 1e-4 the creep needs ln(sqrt(eps) / 1e-4) / eps ~ 150 whole steps
+    start = np.array([0.0, 1e-4])
+    res = minimize(_MaskedSaddle(), start)
+    plain = minimize(_MaskedSaddle(), start, NewtonOptions(creep_steps=0))
+    assert res.converged and res.stable and plain.converged
+    assert res.iterations < 80 < 140 < plain.iterations
+    assert res.history[:, 2].max() > 1.0  # extended whole steps
+    # along the ray the creep follows: the same minimum, on the same side
+    np.testing.assert_allclose(res.x, [0.0, np.sqrt(_MaskedSaddle.eps)], atol=1e-9)
+    np.testing.assert_allclose(res.x, plain.x, atol=1e-9)
+    with pytest.raises(InvalidParameterError, match="creep_steps"):
+        NewtonOptions(creep_steps=-1)
+
+
 def test_decrement_exit_does_not_accept_a_residual_above_rtol():
     """Flat energy, constant gradient 1e-8 (a round-off floor): the Newton decrement is tiny,
     but the residual is 10x rtol; the old exit reported CONVERGED here."""

@@ -8,7 +8,8 @@ the classical one (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 3.2
 
 1. factor ``H + tau M``, raising ``tau`` until positive definite (so the step is a descent
    direction and saddle points repel), lowering it again after good steps;
-2. backtracking Armijo line search on the energy (the merit function);
+2. backtracking Armijo line search on the energy (the merit function); a whole step that
+   creeps (see below) is extended along its own direction while the energy keeps falling;
 3. stop when the weighted gradient norm is below ``rtol`` times the force scale (a pure Newton
    step whose decrement is below ``decrement_tol`` times the energy scale is taken whole, without
    a line search, but the residual test still decides);
@@ -18,6 +19,14 @@ the classical one (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 3.2
    negative curvature with a second-order Armijo test (Moré & Sorensen, *Math. Programming* 16,
    1979) and continues; the same happens when the iteration stalls (no decrease) on an
    indefinite Hessian. An equilibrium that stays unstable ends with ``Status.SADDLE``.
+
+Creeping: near a bifurcation the shift (or the convex Hessian) that makes an indefinite
+Hessian positive definite also masks its direction of negative curvature; whole steps then
+slide off the saddle along it by a few per cent per iteration, the residual never falling
+(hundreds of iterations). After ``creep_steps`` such steps each further whole step is tried
+at 2, 4, 8, ... times its length (within the objective's step bound) while the energy keeps
+falling with the Armijo condition: the same ray the creep follows, covered in one iteration.
+
 """
 
 from __future__ import annotations
@@ -129,6 +138,10 @@ class NewtonOptions:
     saddle_escapes
         Steps along negative curvature allowed before an unstable exit is reported as
         ``Status.SADDLE``.
+    creep_steps
+        Consecutive whole steps on an indefinite Hessian, below the ``endgame`` residual, that
+        do not lower the residual by a tenth, after which whole steps are extended along
+        their direction (see the module docstring; 0 disables it).
     """
 
     max_iterations: int = 200
@@ -144,6 +157,7 @@ class NewtonOptions:
     keep_modes: bool = False
     stability_tol: float = 1e-12
     saddle_escapes: int = 10
+    creep_steps: int = 3
 
     def __post_init__(self) -> None:
         if self.max_iterations < 1:
@@ -152,7 +166,7 @@ class NewtonOptions:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise InvalidParameterError(f"NewtonOptions.{name}", f"must be > 0; got {v}")
-        for name in ("eigenvalues", "saddle_escapes"):
+        for name in ("eigenvalues", "saddle_escapes", "creep_steps"):
             v = getattr(self, name)
             if int(v) != v or v < 0:
                 raise InvalidParameterError(
@@ -197,6 +211,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     stall = False  # a null step on an indefinite Hessian: check for a saddle at the top
     stall_checked = False  # ... once until the next escape
     floor_steps = 0  # whole Newton steps that did not lower the residual
+    creep = 0  # whole steps on an indefinite Hessian that did not lower the residual
     while it < opt.max_iterations:
         res = float(_norm(w * g)) / fscale
         if not np.isfinite(f) or not np.isfinite(res):
@@ -338,19 +353,45 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 continue
             status = Status.LINE_SEARCH_FAILED
             break
+        if opt.creep_steps and creep >= opt.creep_steps and alpha == 1.0 and not pure:
+            alpha, xt = _extend(obj, x, d, f, slope, xt, ft, opt.armijo)
         x = xt
         floor_steps = 0
         obj.accept(x)
         # exact Hessian (mode 1) unless the backoff asks for the convex one next (mode 2)
         exact = skip_exact == 0 or not convex
         f, g, H = obj.evaluate(x, True, 1 if exact else 2)
-        history.append((f, float(_norm(w * g)) / fscale, alpha, shift))
+        new = float(_norm(w * g)) / fscale
+        history.append((f, new, alpha, shift))
+        slid = not pure and alpha >= 1.0 and res < opt.endgame and new >= 0.9 * res
+        creep = creep + 1 if slid else 0
         log.debug(
             "newton %d: E=%.6e res=%.3e alpha=%.3g shift=%.3g", it, f, history[-1][1], alpha, shift
         )
     res = float(_norm(w * g)) / fscale
     floor = _residual_floor(obj) / fscale
     return _result(x, status, it, n_fact, f, res, dec, history, spec, escapes, floor)
+
+
+#: Longest extension of a creeping whole step (a factor of 2 per energy evaluation)
+MAX_EXTENSION = 8.0
+
+
+def _extend(obj, x, d, f, slope, xt, ft, armijo):  # type: ignore[no-untyped-def]
+    """The whole step ``d`` (point ``xt``, energy ``ft``) doubled while the doubled step stays
+    within the objective's step bound, keeps the Armijo condition and lowers the energy
+    further; returns the step fraction reached and its point."""
+    alpha = 1.0
+    while 2.0 * alpha <= MAX_EXTENSION:
+        a = 2.0 * alpha
+        if obj.max_step(x, a * d) < 1.0:
+            break
+        xa = obj.retract(x, d, a)
+        fa = obj.evaluate(xa, False, False)[0]
+        if not (np.isfinite(fa) and fa < ft and fa <= f + armijo * a * slope):
+            break
+        alpha, xt, ft = a, xa, fa
+    return alpha, xt
 
 
 def _residual_floor(obj: Objective) -> float:
