@@ -8,7 +8,8 @@
   markers for non-physical states), and :func:`plot_heatmap` shows a numeric output as a
   heat map (on a grid, cells; otherwise coloured points).
 
-Only ``status == "ok"`` rows enter curves and heat maps; they take the table
+Only ``status == "ok"`` rows enter curves and heat maps, and those whose state is not physical
+(``physical`` false) are ringed in red (curves) or crossed (heat maps); they take the table
 (:class:`pyarrow.Table`), not the run files.
 """
 
@@ -55,6 +56,18 @@ def _unit(table: Any, name: str) -> str:
 
 def _ok(table: Any) -> np.ndarray:
     return np.array([s == "ok" for s in _column(table, "status")], dtype=bool)
+
+
+def _unphysical(table: Any) -> np.ndarray:
+    """Rows whose state failed a check (``physical`` false: unconverged, unstable or passing
+    through itself); unknown (null) is not counted as failed."""
+    if "physical" not in table.column_names:
+        return np.zeros(table.num_rows, dtype=bool)
+    return np.array([p is False for p in _column(table, "physical")], dtype=bool)
+
+
+_RED = "#b2182b"
+_NOT_PHYSICAL = "not physical (see physical_reason)"
 
 
 def plot_curve(
@@ -116,6 +129,9 @@ def plot_curve(
                         capsize=3,
                         label=f"measured ({data.name})",
                     )
+        bad = ok & _unphysical(table) & np.isfinite(y_all) & np.isfinite(x_all)
+        if bad.any():  # drawn as results would lie: ring them, as every figure flags them
+            ax.plot(x_all[bad], y_all[bad], "o", ms=8, mfc="none", mec=_RED, label=_NOT_PHYSICAL)
         n_bad = int((~ok).sum())
         if n_bad:
             ax.text(
@@ -201,6 +217,10 @@ def plot_heatmap(table: Any, x: str, y: str, output: str, *, title: str = "") ->
         mesh = ax.pcolormesh(_edges(ux), _edges(uy), grid, shading="flat", cmap="viridis")
     else:
         mesh = ax.scatter(xs, ys, c=zs, s=50, cmap="viridis")
+    bad = ok & _unphysical(table)
+    if bad.any():
+        ax.scatter(xs[bad], ys[bad], s=40, marker="x", color=_RED, label=_NOT_PHYSICAL)
+        ax.legend(fontsize=7, loc="upper right")
     fig.colorbar(mesh, ax=ax, label=output + _unit(table, output))
     ax.set_xlabel(x + _unit(table, x))
     ax.set_ylabel(y + _unit(table, y))
