@@ -105,6 +105,9 @@ def test_cantilever_self_weight_small_deflection():
     )
     grav = Gravity(density=1.1, area=area, fluid_density=0.0)
     w = grav.line_weight(1)[0]
+    # the load itself, by hand (not from line_weight, which the deflection below would only
+    # echo): 1.1 g/cm^3 = 1.1e-6 kg/mm^3, times the area (mm^2) and g = 9.80665 m/s^2 -> N/mm
+    assert w == pytest.approx(1.1e-6 * area * 9.80665, rel=1e-12)
     res = solve_static(model, Supports.clamp_ends(n), Loads(gravity=grav))
     expected = w * length**4 / (8 * B)
     assert expected < 0.05 * length  # small-deflection regime
