@@ -72,3 +72,12 @@ def test_simulate_refuses_a_retracing_path_before_computing(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("rotomorph: error: filaments[0]: segments[0]: turns back on itself")
     assert not (tmp_path / "run").exists()
+
+
+def test_a_lattice_only_contact_key_on_filaments_is_refused_not_ignored():
+    # before: branch = "continuous" on a filament design was accepted, ignored by the
+    # filament solve, and recorded in summary.json as if it had been applied
+    data = _design(LINE)
+    parse_design({**data, "contact": {"floor": True}})
+    with pytest.raises(InvalidDesignError, match=r"contact\.branch applies to lattices"):
+        parse_design({**data, "contact": {"floor": True, "branch": "continuous"}})

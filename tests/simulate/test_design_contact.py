@@ -47,9 +47,7 @@ def test_self_contact_keeps_the_ring_apart():
         "floor": False,
         "gravity": False,
         "friction": 0.0,
-        "branch": "lowest",
-        "path_check": 1,
-    }
+    }  # no branch or path_check: lattice-only, not applied to a filament, so not recorded
 
 
 def test_on_the_floor_under_buoyant_weight():
@@ -113,7 +111,11 @@ def test_the_floor_branch_reaches_the_lattice_ramp_and_a_bad_one_is_refused():
     lattice = sinusoidal_lattice(n=2, ghost_nodes=2)
     for branch in ("lowest", "continuous"):
         design = parse_design(
-            {**RING, "contact": {"floor": True, "gravity": True, "branch": branch}}
+            {
+                "schema_version": 1,
+                "lattice": {"n": 2},
+                "contact": {"floor": True, "gravity": True, "branch": branch},
+            }
         )
         assert lattice_surroundings(design.contact, lattice, 175.0)["branch"] == branch
     with pytest.raises(InvalidDesignError, match="branch"):

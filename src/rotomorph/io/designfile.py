@@ -622,6 +622,15 @@ class Design(_Model):
             raise ValueError(
                 "contact.path_check applies to lattices; remove it from a filament design"
             )
+        if (
+            self.filaments
+            and self.contact is not None
+            and "branch" in self.contact.model_fields_set
+        ):
+            raise ValueError(
+                "contact.branch applies to lattices resting on the floor; remove it from a "
+                "filament design"
+            )
         refusal = design_size(self).refusal()
         if refusal:
             raise ValueError(f"{refusal} over all filaments; split the design or increase spacing")

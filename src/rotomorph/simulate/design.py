@@ -199,6 +199,8 @@ def _simulate_filaments(
     record = surroundings_record(design.contact, temperature, along_ramp=True)
     if record is None:
         return sim
+    for lattice_only in ("branch", "path_check"):  # not applied to filaments: not recorded
+        record.pop(lattice_only, None)
     return replace(sim, metadata={**sim.metadata, "contact": record})
 
 
