@@ -123,15 +123,32 @@ def step_count(design: Any, steps: int) -> int:
 HELIX_FIT_RTOL = 0.1
 
 
-def _helix_describes(sim: FilamentSimulation) -> bool:
+#: A fitted helix of fewer turns than this (a filament bent through less than one radian about
+#: the helix axis) is a gently bent filament, not a helix or coil.
+HELIX_MIN_TURNS = 1.0 / (2.0 * np.pi)
+
+
+def _helix_rejection(sim: FilamentSimulation) -> str | None:
+    """Why the fitted helix does not describe the shape (``None``: it does)."""
     h = sim.helix
-    return h is not None and bool(h.rms_residual <= HELIX_FIT_RTOL * h.radius)
+    if h is None:
+        return "no helix fitted"
+    if not h.rms_residual <= HELIX_FIT_RTOL * h.radius:
+        return f"rms residual above {HELIX_FIT_RTOL:g} x the fitted radius"
+    if not h.turns >= HELIX_MIN_TURNS:
+        return (
+            f"the fitted helix makes {h.turns:.2g} turn (bent through less than one radian): a "
+            "gently bent filament, not a helix or coil"
+        )
+    return None
 
 
 def _filament_summary(sim: FilamentSimulation) -> dict[str, Any]:
     # a shape label and a helix fit only where the fitted helix describes the shape (not on
-    # sinusoids or graded filaments, whose fits leave millimetre residuals)
-    fits = _helix_describes(sim)
+    # sinusoids or graded filaments, whose fits leave millimetre residuals, nor on a
+    # straightened sinusoid that a helix of 70 mm radius and 0.06 turn fits to 0.1 mm)
+    rejection = _helix_rejection(sim)
+    fits = rejection is None
     straight = sim.morphology.value == "straight"
     out: dict[str, Any] = {
         "name": sim.name,
@@ -144,7 +161,8 @@ def _filament_summary(sim: FilamentSimulation) -> dict[str, Any]:
         out["helix_fit_rejected"] = {
             "rms_residual_mm": sim.helix.rms_residual,
             "radius_mm": sim.helix.radius,
-            "reason": f"rms residual above {HELIX_FIT_RTOL:g} x the fitted radius",
+            "turns": sim.helix.turns,
+            "reason": rejection,
         }
     if sim.helix is not None and fits:
         out["helix"] = {
