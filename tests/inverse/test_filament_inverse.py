@@ -77,12 +77,17 @@ def test_paper_like_targets_are_reached_or_reported(table, family):
     }[family]
     design = design_filament(curve_points(spec), spacing=0.1, table=table)
     length = float(np.sum(np.linalg.norm(np.diff(design.target, axis=0), axis=1)))
+    # the radii lie inside the table's reach: helix and spiral must be reached, and then the
+    # re-simulated shape matches to ~5e-6 of the length (2e-2 let a design that ignores the
+    # printed stretch, 1.3e-2, or a rotation rate 10 % off, 1.8e-3, pass)
+    assert design.fully_reachable == (family != "tendril")
     if design.fully_reachable:
-        assert design.rms_error / length < 0.02
+        assert design.rms_error / length < 1e-4
     else:
         stretches = design.unreachable_stretches()
         assert stretches and all(a <= b for a, b, _ in stretches)
         assert any("not reachable" in n for n in design.notes)
+        assert design.rms_error / length < 2e-3  # 9 vertices at the perversion: 7e-4
     if family == "tendril":
         # the perversion is a straight point: the handedness flips and so does the active side
         assert design.flips == 1
