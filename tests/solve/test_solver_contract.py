@@ -99,6 +99,26 @@ def test_two_collinear_segments_at_a_junction_reproduce_the_rod(rng):
     np.testing.assert_allclose(out[1][1], out[0][1], rtol=0, atol=1e-12 * np.abs(out[0][1]).max())
 
 
+def test_stencil_stiffness_is_the_edge_mean_and_isotropic_at_junctions():
+    """Per-stencil (B1, B2, C) by hand: the mean of the two edges' values; at a junction (its
+    two edges' frames need not agree) the bending stiffness is the isotropic mean of all four
+    values. Every other test of a junction uses B1 = B2, where dropping that would not show."""
+    pts = np.c_[np.arange(6.0), 0.1 * np.arange(6.0) ** 2, np.zeros(6)]
+    net = Network(pts, Network.chain(pts).edges, branch=np.isin(np.arange(6), [2]))
+    model = Model(
+        net,
+        bending_stiffness1=np.array([1.0, 2.0, 3.0, 4.0, 5.0]),
+        bending_stiffness2=np.array([10.0, 20.0, 30.0, 40.0, 50.0]),
+        twist_stiffness=np.array([0.1, 0.2, 0.3, 0.4, 0.5]),
+        axial_stiffness=40.0,
+    )
+    assert model.stencils.junction.tolist() == [False, True, False, False]  # edges 1 and 2
+    b1, b2, c = model.stencil_stiffness
+    np.testing.assert_allclose(b1, [1.5, (2 + 3 + 20 + 30) / 4, 3.5, 4.5], rtol=1e-15)
+    np.testing.assert_allclose(b2, [15.0, (2 + 3 + 20 + 30) / 4, 35.0, 45.0], rtol=1e-15)
+    np.testing.assert_allclose(c, [0.15, 0.25, 0.35, 0.45], rtol=1e-15)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [
