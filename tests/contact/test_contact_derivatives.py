@@ -154,6 +154,9 @@ def test_friction_force_is_coulomb_when_sliding_and_smoothed_when_sticking(rng):
     assert lag.normal_force.min() > 0
     on_floor = np.all(lag.weights[:, 1:] == 0, axis=1)
     assert on_floor.sum() == 3 and (~on_floor).sum() >= 4  # floor nodes 0-2 and pair contacts
+    # the lagged normal forces are the barrier's: together, what the floor carries
+    (on_the_floor,) = pot.obstacle_forces(pts)
+    assert lag.normal_force[on_floor].sum() == pytest.approx(-on_the_floor[2], rel=1e-12)
     bound = np.zeros((6, 3))
     bound[lag.nodes[on_floor, 0], 0] = 0.3 * lag.normal_force[on_floor]
     for slide, f1 in ((0.05, 1.0), (0.5e-4, 0.75)):
