@@ -81,3 +81,32 @@ def test_a_lattice_only_contact_key_on_filaments_is_refused_not_ignored():
     parse_design({**data, "contact": {"floor": True}})
     with pytest.raises(InvalidDesignError, match=r"contact\.branch applies to lattices"):
         parse_design({**data, "contact": {"floor": True, "branch": "continuous"}})
+
+
+@pytest.mark.parametrize(
+    ("segment", "message"),
+    [
+        (
+            {"kind": "arc", "radius": 0.1, "angle_deg": 90},
+            "segments[1]: an arc of radius 0.1 mm is tighter than the filament radius 0.3 mm",
+        ),
+        (  # crest radius 0.5 um: validate accepted it and sampled straight across the crests
+            {"kind": "sinusoid", "amplitude": 50.0, "wavelength": 1.0},
+            "segments[1]: the sinusoid's crests bend at radius wavelength^2/(4 pi^2 amplitude) "
+            "= 0.000507 mm, below the filament radius 0.3 mm",
+        ),
+    ],
+)
+def test_turns_tighter_than_the_filament_radius_are_refused(segment, message):
+    with pytest.raises(InvalidDesignError) as err:
+        parse_design(_design(LINE, segment))
+    assert message in str(err.value)
+    ok = {**segment, "radius": 0.3} if segment["kind"] == "arc" else {**segment, "amplitude": 0.08}
+    parse_design(_design(LINE, ok))
+
+
+def test_a_lattice_whose_crests_are_tighter_than_its_filaments_is_refused():
+    base = {"schema_version": 1, "lattice": {"n": 3, "spacing": 5.0}}
+    parse_design({**base, "lattice": {**base["lattice"], "amplitude": 2.0}})  # A/l = 0.4
+    with pytest.raises(InvalidDesignError, match=r"use amplitude <= 2\.11 mm"):
+        parse_design({**base, "lattice": {**base["lattice"], "amplitude": 10.0}})

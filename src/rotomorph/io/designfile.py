@@ -353,6 +353,10 @@ class Filament(_Control, _Process):
 
     @model_validator(mode="after")
     def _printable_path(self) -> Filament:
+        for i, seg in enumerate(self.segments):  # turns tighter than the filament's own radius
+            bend = _bend_radius(seg)
+            if bend is not None and bend < self.radius:
+                raise ValueError(f"segments[{i}]: {_too_tight(seg, bend, self.radius)}")
         # after _size: the path is built only for a design of a size that is accepted
         try:
             pts, owner = self._points()
@@ -421,6 +425,31 @@ class Filament(_Control, _Process):
         return "rotation", 0.0
 
 
+def _bend_radius(seg: Any) -> float | None:
+    """Smallest radius of curvature (mm) of an arc or sinusoid segment's centre line."""
+    if seg.kind == "arc":
+        return float(seg.radius)
+    if seg.kind == "sinusoid":  # at the crests of A sin(2 pi x / lambda): lambda^2/(4 pi^2 A)
+        return float(seg.wavelength**2 / (4 * math.pi**2 * seg.amplitude))
+    return None
+
+
+def _too_tight(seg: Any, bend: float, radius: float) -> str:
+    """Why a segment bending at radius ``bend`` (mm) cannot be printed with filament ``radius``."""
+    overlap = "its inner side would overlap itself"
+    if seg.kind == "arc":
+        return (
+            f"an arc of radius {bend:.4g} mm is tighter than the filament radius {radius:g} mm: "
+            f"{overlap}; use radius >= {radius:g} mm"
+        )
+    most = seg.wavelength**2 / (4 * math.pi**2 * radius)
+    return (
+        f"the sinusoid's crests bend at radius wavelength^2/(4 pi^2 amplitude) = {bend:.3g} mm, "
+        f"below the filament radius {radius:g} mm: {overlap}; use amplitude <= {most:.3g} mm "
+        "or a longer wavelength"
+    )
+
+
 def _geometry(seg: Any) -> Any:
     if seg.kind == "line":
         return Line(seg.length)
@@ -466,6 +495,19 @@ class LatticeModel(_Process):
         le=LIMITS["extent"].maximum,
         description="arc length (mm) of each pi flip of the active side (0: a step)",
     )
+
+    @model_validator(mode="after")
+    def _crests_printable(self) -> LatticeModel:
+        if self.amplitude > 0:
+            bend = self.spacing**2 / (4 * math.pi**2 * self.amplitude)
+            if bend < self.radius:
+                most = self.spacing**2 / (4 * math.pi**2 * self.radius)
+                raise ValueError(
+                    f"the edges' crests bend at radius spacing^2/(4 pi^2 amplitude) = {bend:.3g} "
+                    f"mm, below the filament radius {self.radius:g} mm: their inner side would "
+                    f"overlap itself; use amplitude <= {most:.3g} mm or a larger spacing"
+                )
+        return self
 
     @model_validator(mode="after")
     def _size(self) -> LatticeModel:
