@@ -7,7 +7,7 @@ import stat
 
 import pytest
 
-from rotomorph.io.atomic import atomic_path, atomic_write_bytes, atomic_write_text
+from rotomorph.io.atomic import atomic_folder, atomic_path, atomic_write_bytes, atomic_write_text
 
 
 def test_write_bytes_and_text(tmp_path):
@@ -66,3 +66,22 @@ def test_final_file_has_normal_permissions(tmp_path):
 def test_missing_folder_raises(tmp_path):
     with pytest.raises(FileNotFoundError):
         atomic_write_text(tmp_path / "nope" / "x.txt", "x")
+
+
+def test_an_unwritable_folder_is_reported_with_the_target_name(tmp_path, monkeypatch):
+    # before: the error named the temporary file (".x.gcode.tmp-host-123-abc.gcode")
+    import tempfile
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(tempfile, "mkdtemp", refuse)
+    target = tmp_path / "x.gcode"
+    with pytest.raises(PermissionError) as err:
+        atomic_write_text(target, "G1")
+    assert err.value.filename == str(target)
+    assert err.value.strerror == f"cannot write in {tmp_path} (Permission denied)"
+    with pytest.raises(PermissionError) as err, atomic_folder(tmp_path / "run"):
+        pass
+    assert err.value.filename == str(tmp_path / "run")

@@ -31,3 +31,26 @@ def test_a_lattice_summary_has_no_final_block_without_its_checks():
     assert {"converged", "stable", "min_clearance", "area_ratio"} <= set(end)
     assert summary["physical"]["verdict"] in ("yes", "no", "unknown")
     json.dumps(summary, allow_nan=False)
+
+
+def test_the_api_takes_a_model_by_name_and_refuses_anything_else():
+    # before: rotomorph.simulate(design, model="calibrated") raised AttributeError
+    # ('str' object has no attribute 'transition_width') from inside the materials model
+    import pytest
+
+    import rotomorph
+    from rotomorph.errors import InvalidParameterError
+
+    design = parse_design(
+        {
+            "schema_version": 1,
+            "filaments": [{"spacing": 1.0, "segments": [{"kind": "line", "length": 6.0}]}],
+        }
+    )
+    named = rotomorph.simulate(design, steps=1, model="warner-terentjev")
+    default = rotomorph.simulate(design, steps=1, model=None)
+    assert named.positions.shape == default.positions.shape
+    assert rotomorph.predict(design, model="room-temperature")[0].curvature >= 0.0
+    for bad in ("calibrat", 3):
+        with pytest.raises(InvalidParameterError, match="model"):
+            rotomorph.simulate(design, steps=1, model=bad)

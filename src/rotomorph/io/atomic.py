@@ -207,6 +207,12 @@ def check_writable(path: str | os.PathLike[str], field: str, *, create_parent: b
     return parent
 
 
+def _cannot_write(err: OSError, target: Path, folder: Path) -> OSError:
+    """``err`` (from creating a temporary in ``folder``) re-addressed to ``target``."""
+    why = f"cannot write in {folder} ({err.strerror or err})"
+    return type(err)(err.errno, why, str(target)) if err.errno else OSError(why)
+
+
 _RENAME_EXCHANGE = 2
 
 
@@ -249,7 +255,10 @@ def atomic_folder(path: str | os.PathLike[str]) -> Iterator[Path]:
     target = Path(path)
     parent = target.parent if str(target.parent) else Path(".")
     remove_stale(parent)
-    tmp = Path(tempfile.mkdtemp(prefix=temporary_prefix(target), dir=parent))
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=temporary_prefix(target), dir=parent))
+    except OSError as err:
+        raise _cannot_write(err, target, parent) from None
     try:
         yield tmp
         os.chmod(tmp, 0o777 & ~_UMASK)
@@ -297,7 +306,12 @@ def atomic_path(path: str | os.PathLike[str], *, fsync: bool = True) -> Iterator
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
     _remove_stale_once(folder)
-    fd, name = tempfile.mkstemp(dir=folder, prefix=temporary_prefix(target), suffix=target.suffix)
+    try:
+        fd, name = tempfile.mkstemp(
+            dir=folder, prefix=temporary_prefix(target), suffix=target.suffix
+        )
+    except OSError as err:  # name the file asked for, not the temporary one
+        raise _cannot_write(err, target, folder) from None
     os.close(fd)
     tmp = Path(name)
     try:

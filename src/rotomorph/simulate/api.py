@@ -83,8 +83,14 @@ def predict(
         A lattice design, or a filament whose natural field varies along it (use
         :func:`simulate`).
     """
-    from rotomorph.materials.natural import natural_field
+    from rotomorph.materials.natural import FilamentModel, named_model, natural_field
 
+    if isinstance(model, str):  # a name, as simulate accepts
+        model = named_model(model)
+    if model is not None and not isinstance(model, FilamentModel):
+        from rotomorph.errors import InvalidParameterError
+
+        raise InvalidParameterError("model", f"must be a FilamentModel or its name; got {model!r}")
     if isinstance(design, PrintProgram):
         return natural_field(design, None, temperature, model=model).morphology()
     d = _design(design)

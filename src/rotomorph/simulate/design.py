@@ -27,7 +27,7 @@ from rotomorph.analysis.curvature import network_relative_curvature_change
 from rotomorph.errors import InvalidDesignError, InvalidParameterError
 from rotomorph.io.designfile import design_size, with_spacing
 from rotomorph.io.results import RunResults, to_jsonable
-from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.natural import FilamentModel, named_model
 from rotomorph.simulate.filament import (
     ACTUATION_TEMPERATURE,
     PRINT_TEMPERATURE,
@@ -439,7 +439,7 @@ def simulate_design(
     steps: int = 8,
     start_temperature: float | None = None,
     temperature: float | None = None,
-    model: FilamentModel | None = None,
+    model: FilamentModel | str | None = None,
     spacing: float | None = None,
     actuation: str | None = None,
     progress: Progress | None = None,
@@ -458,8 +458,10 @@ def simulate_design(
         heated by a temperature-driven actuation (``program``, ``thermal``); refused with the
         paper's x-readings, which ramp x from 0 to 0.75.
     model
-        Filament modelling choices (default calibrated :class:`FilamentModel`); filaments and
-        temperature-driven lattices.
+        Filament modelling choices (default calibrated :class:`FilamentModel`), or its name
+        (:func:`~rotomorph.materials.natural.named_model`: ``"calibrated"``,
+        ``"warner-terentjev"``, ``"room-temperature"``); filaments and temperature-driven
+        lattices.
     spacing
         Override the filaments' vertex spacing (mm; the design is re-validated); coarser is
         faster. Filaments only.
@@ -485,6 +487,8 @@ def simulate_design(
         raise InvalidDesignError(
             "lattice", "simulate handles filaments or a lattice, not both; split the design file"
         )
+    if isinstance(model, str):  # a name, as on the command line (--model)
+        model = named_model(model)
     check_run_options(
         "lattice" if design.lattice is not None else "filaments",
         steps=steps,

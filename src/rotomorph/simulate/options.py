@@ -60,6 +60,14 @@ def check_run_options(
     InvalidParameterError
         Naming the option and the fix.
     """
+    from rotomorph.materials.natural import FilamentModel
+
+    if model is not None and not isinstance(model, FilamentModel):
+        raise InvalidParameterError(
+            "model",
+            f"must be a FilamentModel or the name of one ('calibrated', 'warner-terentjev', "
+            f"'room-temperature'); got {model!r}",
+        )
     if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
         raise InvalidParameterError(
             "steps", f"must be a whole number in [1, {MAX_STEPS}]; got {steps!r}"
