@@ -108,6 +108,24 @@ def test_unreachable_curvature_is_reported_not_approximated_silently(table):
     assert b - a > 3.0 and worst > 0.05
 
 
+def test_segment_distances_of_the_self_intersection_check_are_exact():
+    """The target's self-intersection check against the contact layer's (compiled) segment
+    distance, on pairs whose closest points mostly lie at an end; the only self-intersecting
+    target above (a tight helix) has them inside, where dropping the end re-clamp of s passes."""
+    from rotomorph.contact.distance import pair_distances
+    from rotomorph.inverse.curve import _segment_distances
+
+    rng = np.random.default_rng(1)
+    q = rng.normal(size=(60, 2, 3))
+    q[20:, 1] = q[20:, 0] + rng.uniform(0.3, 2.0, (40, 1)) * [1.0, 0.5, -0.2]  # parallel to p
+    q[20:40, 1] += 1e-3 * rng.normal(size=(20, 3))  # nearly
+    p0, p1 = np.zeros(3), np.array([1.0, 0.5, -0.2])
+    got = _segment_distances(p0, p1, q[:, 0], q[:, 1])
+    pts = np.vstack([[p0, p1], q.reshape(-1, 3)])
+    quads = np.array([[0, 1, 2 + 2 * k, 3 + 2 * k] for k in range(60)])
+    np.testing.assert_allclose(got, pair_distances(pts, quads), rtol=0, atol=1e-12)
+
+
 def test_bad_targets_have_clear_errors(table):
     with pytest.raises(InvalidDesignError, match="at least 3 points"):
         design_filament(np.zeros((2, 3)), table=table)
