@@ -214,10 +214,17 @@ def _output_folder(path: str, *, force: bool, inputs: Sequence[Path] = ()) -> It
         yield tmp
 
 
-def _check_writable(path: Path, *, create_parent: bool) -> None:
-    """Refuse an -o/--output that cannot be written, before any computation."""
+def _check_writable(path: Path, *, create_parent: bool, inputs: Sequence[Path] = ()) -> None:
+    """Refuse an -o/--output that cannot be written, or that is one of the command's
+    ``inputs`` (it would be replaced), before any computation."""
     from rotomorph.io.atomic import check_writable
 
+    for item in inputs:
+        if path.exists() and item.exists() and path.resolve() == item.resolve():
+            raise UsageError(
+                f"-o/--output: {path}: is the input {item}; writing there would replace it: "
+                "give another file name"
+            )
     check_writable(path, "-o/--output", create_parent=create_parent)
 
 
@@ -320,7 +327,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
-    _check_writable(out, create_parent=False)
+    _check_writable(out, create_parent=False, inputs=[Path(args.design)])
     if not (args.cure >= 0 and math.isfinite(args.cure)):
         raise UsageError(f"--cure: must be a UV dwell in seconds >= 0; got {args.cure:g}")
     machine = _machine(args)
@@ -422,7 +429,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else path.parent / "view.html"
     if out.is_dir():
         raise UsageError(f"-o/--output: {out}: is a folder; give an .html file name")
-    _check_writable(out, create_parent=True)
+    _check_writable(out, create_parent=True, inputs=[path])
     write_viewer(results, out, field=args.field)
     _print(f"wrote {out}")
     if args.open:
@@ -466,7 +473,7 @@ def _cmd_inverse(args: argparse.Namespace) -> int:
         raise UsageError("-o/--output: give the design file to write, ending in .toml")
     if out.exists() and not args.force:
         raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
-    _check_writable(out, create_parent=True)
+    _check_writable(out, create_parent=True, inputs=[target])
     with _progress(0, "inverse") as bar:
         text = inverse_file(target, out, progress=lambda it, j: bar.update(1))
     _print(text)

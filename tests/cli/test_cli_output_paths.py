@@ -129,3 +129,24 @@ def test_force_never_replaces_the_current_folder(tmp_path, capsys, monkeypatch, 
                             "what is in it: give a new folder"), err  # fmt: skip
     assert sorted(p.name for p in tmp_path.iterdir()) == ["work"]
     assert [p.name for p in work.iterdir()] == ["design.toml"]
+
+
+def test_an_output_that_is_the_input_is_refused(tmp_path, capsys):
+    # before: `gcode d.toml -o d.toml` replaced the design with G-code, `view RUN -o
+    # RUN/results.h5` the results with HTML, `inverse t.toml -o t.toml --force` the target
+    design = tmp_path / "d.toml"
+    design.write_text(DESIGN)
+    target = tmp_path / "t.toml"
+    target.write_text((ROOT / "examples/targets/tendril.toml").read_text())
+    cases = [
+        (["gcode", str(design), "-o", str(design)], design),
+        (["inverse", str(target), "-o", str(target), "--force"], target),
+    ]
+    for argv, item in cases:
+        before = item.read_bytes()
+        assert main(argv) == EXIT_USAGE
+        assert capsys.readouterr().err.strip() == (
+            f"rotomorph: error: -o/--output: {item}: is the input {item}; writing there would "
+            "replace it: give another file name"
+        )
+        assert item.read_bytes() == before

@@ -280,3 +280,10 @@ def test_end_to_end_figure_rings_each_filament_by_its_own_verdict(run_file):
     coil_end = round(float(res.fields["end_to_end_ratio_per_filament"][-1, 0]), 6)
     assert ringed == [((175.0,), (coil_end,))]
     assert "not physical" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_view_refuses_to_write_over_its_results_file(run_file, capsys):
+    # before: `rotomorph view RUN -o RUN/results.h5` replaced the run's results with HTML
+    assert main(["view", str(run_file), "-o", str(run_file), "--no-open"]) == EXIT_USAGE
+    assert "is the input" in capsys.readouterr().err
+    assert read_results(run_file).n_steps == 3
