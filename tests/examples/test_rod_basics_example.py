@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_bvp
+from scipy.integrate import solve_bvp, trapezoid
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "rod_basics.py"
 
@@ -25,7 +25,7 @@ def _elastica_tip_deflection(length: float, stiffness: float, tip: float, weight
     sol = solve_bvp(rhs, lambda a, b: np.array([a[0], b[1]]), s, np.zeros((2, s.size)), tol=1e-10)
     assert sol.success
     fine = np.linspace(0.0, length, 20001)
-    return float(np.trapezoid(np.sin(sol.sol(fine)[0]), fine))
+    return float(trapezoid(np.sin(sol.sol(fine)[0]), fine))
 
 
 def test_rod_basics_example(capsys):
