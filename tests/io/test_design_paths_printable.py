@@ -110,3 +110,10 @@ def test_a_lattice_whose_crests_are_tighter_than_its_filaments_is_refused():
     parse_design({**base, "lattice": {**base["lattice"], "amplitude": 2.0}})  # A/l = 0.4
     with pytest.raises(InvalidDesignError, match=r"use amplitude <= 2\.11 mm"):
         parse_design({**base, "lattice": {**base["lattice"], "amplitude": 10.0}})
+
+
+def test_a_material_of_the_wrong_kind_is_named_in_plain_english():
+    # before: "'lce' is a active material; give a passive one"
+    fil = {"passive_material": "lce", "spacing": 0.5, "segments": [LINE]}
+    with pytest.raises(InvalidDesignError, match="'lce' is an active material; give a passive one"):
+        parse_design({"schema_version": 1, "filaments": [fil]})

@@ -164,9 +164,13 @@ def _check_material(name: str, kind: str) -> str:
             f"unknown material {name!r}; use one of {', '.join(known_materials())}"
         ) from None
     if mat.kind != kind:
-        article = "an" if kind == "active" else "a"
-        raise ValueError(f"{name!r} is a {mat.kind} material; give {article} {kind} one")
+        raise ValueError(f"{name!r} is {_article(mat.kind)} material; give {_article(kind)} one")
     return name
+
+
+def _article(word: str) -> str:
+    """``word`` with its indefinite article ("an active", "a passive")."""
+    return f"{'an' if word[:1] in tuple('aeiou') else 'a'} {word}"
 
 
 ActiveMaterial = Annotated[
