@@ -527,7 +527,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("design", metavar="DESIGN.toml")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="folder to write")
-    p.add_argument("--steps", type=int, default=8, help="heating steps (default 8)")
+    p.add_argument(
+        "--steps",
+        type=int,
+        default=8,
+        help="heating steps (default 8): filaments in equal steps of actuation (temperatures "
+        "crowd around the transition, where the shape changes), lattices in equal steps of "
+        "the ramp parameter",
+    )
     p.add_argument(
         "--temperature",
         type=float,
