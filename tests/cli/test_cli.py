@@ -167,8 +167,10 @@ def test_simulate_filament_writes_everything(tmp_path, capsys):
     assert summary["end_of_ramp"]["end_to_end_ratio"] == pytest.approx(
         res.scalars["end_to_end_ratio"][-1]
     )
-    # stability is not checked by this solver yet: reported as unknown, never as fine
-    assert summary["physical"]["verdict"] in ("yes", "unknown", "no")
+    # every step converged, certified stable and clear of itself (the old check accepted any
+    # of "yes", "unknown" and "no")
+    assert summary["physical"]["verdict"] == "yes"
+    assert summary["physical"]["reason"] == "all checks passed"
     assert summary["filaments"][0]["name"] == "w*=0.25"
     for png in ("shapes.png", "ramp.png", "end_to_end_ratio.png"):
         _non_blank_png(out / "figures" / png)
