@@ -117,3 +117,14 @@ def test_a_material_of_the_wrong_kind_is_named_in_plain_english():
     fil = {"passive_material": "lce", "spacing": 0.5, "segments": [LINE]}
     with pytest.raises(InvalidDesignError, match="'lce' is an active material; give a passive one"):
         parse_design({"schema_version": 1, "filaments": [fil]})
+
+
+def test_the_same_fault_in_several_filaments_is_said_once():
+    # before: "filaments[0].speed: must be >= 0.01 mm/s; got -3.0; also filaments[1].speed:
+    # must be >= 0.01 mm/s; got -3.0; filaments[2].speed: ..." (cut off by the terminal)
+    fil = {"speed": -3.0, "spacing": 0.5, "segments": [LINE]}
+    with pytest.raises(InvalidDesignError) as err:
+        parse_design({"schema_version": 1, "filaments": [fil, fil, fil]})
+    assert str(err.value) == (
+        "filaments[0].speed: must be >= 0.01 mm/s; got -3.0 (also filaments[1], filaments[2])"
+    )

@@ -46,6 +46,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
@@ -778,12 +779,28 @@ def parse_design(data: dict[str, Any]) -> Design:
     try:
         return Design.model_validate(data)
     except ValidationError as exc:
-        errors = [_format_error(e) for e in exc.errors()]
+        errors = _same_fault_once([_format_error(e) for e in exc.errors()])
         field, msg = errors[0]
         more = (
             "" if len(errors) == 1 else "; also " + "; ".join(f"{f}: {m}" for f, m in errors[1:4])
         )
         raise InvalidDesignError(field, msg + more) from None
+
+
+def _same_fault_once(errors: list[tuple[str, str]]) -> list[tuple[str, str]]:
+    """One entry per fault: the same message at the same field of several filaments (or
+    segments) is given once, naming the others, e.g. ``filaments[0].speed: must be >= 0.01
+    mm/s; got -3.0 (also filaments[1], filaments[2])``."""
+    groups: dict[tuple[str, str], list[str]] = {}
+    for field, msg in errors:
+        groups.setdefault((re.sub(r"\[\d+\]", "[]", field), msg), []).append(field)
+    out = []
+    for (_, msg), fields in groups.items():
+        if len(fields) > 1:
+            owners = [re.sub(r"\.[^\[\]]*$", "", f) if "." in f else f for f in fields[1:]]
+            msg = f"{msg} (also {', '.join(owners)})"
+        out.append((fields[0], msg))
+    return out
 
 
 def load_design(path: str | FilePath) -> Design:
