@@ -128,3 +128,31 @@ def test_the_same_fault_in_several_filaments_is_said_once():
     assert str(err.value) == (
         "filaments[0].speed: must be >= 0.01 mm/s; got -3.0 (also filaments[1], filaments[2])"
     )
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (  # before: "schema_version: Input should be 1; got 2"
+            {"schema_version": 2, "filaments": []},
+            "schema_version: must be 1; got 2",
+        ),
+        (  # before: "Input tag 'lines' found using 'kind' does not match any of the expected ..."
+            {"schema_version": 1, "filaments": [{"segments": [{"kind": "lines", "length": 5}]}]},
+            "filaments[0].segments[0]: kind must be one of 'line', 'arc', 'sinusoid', "
+            "'polyline'; got 'lines'",
+        ),
+        (  # before: "List should have at least 1 item after validation, not 0; got []"
+            {"schema_version": 1, "filaments": [{"segments": []}]},
+            "filaments[0].segments: needs at least 1 item(s); got []",
+        ),
+        (  # before: "Input should be a finite number; got nan"
+            {"schema_version": 1, "filaments": [{"speed": float("nan"), "segments": [LINE]}]},
+            "filaments[0].speed: must be a finite number (mm/s); got nan",
+        ),
+    ],
+)
+def test_schema_errors_read_as_the_rest_of_the_messages(data, message):
+    with pytest.raises(InvalidDesignError) as err:
+        parse_design(data)
+    assert str(err.value) == message

@@ -763,6 +763,14 @@ def _format_error(err: ErrorDetails) -> tuple[str, str]:
         what = _TYPE_ERRORS[kind] + (f" ({unit})" if unit else "")
         quoted = " without quotes" if isinstance(got, str) else ""
         msg = f"must be {what}{quoted}; got {got!r} ({type(got).__name__})"
+    elif kind == "literal_error":  # pydantic: "Input should be 'a' or 'b'"
+        msg = f"must be {ctx.get('expected', '')}; got {got!r}"
+    elif kind == "finite_number":
+        msg = f"must be a finite number{' (' + unit + ')' if unit else ''}; got {got!r}"
+    elif kind == "too_short":
+        msg = f"needs at least {ctx.get('min_length')} item(s); got {got!r}"
+    elif kind == "union_tag_invalid":
+        msg = f"kind must be one of {ctx.get('expected_tags', '')}; got {ctx.get('tag')!r}"
     else:
         msg = err["msg"].removeprefix("Value error, ") + (
             f"; got {got!r}" if kind != "value_error" and not isinstance(got, dict) else ""
