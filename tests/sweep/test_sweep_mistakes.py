@@ -92,3 +92,19 @@ def test_cli_a_scheduler_that_is_not_an_address_exits_2(tmp_path, capsys, addres
     assert err.startswith(f"rotomorph: error: --scheduler: {address!r} is not a Dask scheduler")
     assert reason in err and "tcp://HOST:PORT" in err
     assert not out.exists()
+
+
+def test_sweep_schema_errors_read_as_the_design_files_do():
+    # before: "settings.steps: Input should be greater than or equal to 1"
+    data = {
+        "schema_version": 1,
+        "design": DESIGN,
+        "outputs": ["end_to_end_ratio"],
+        "parameters": [{"path": "filaments[0].speed", "values": [1.0]}],
+    }
+    with pytest.raises(InvalidParameterError) as err:
+        parse_sweep({**data, "settings": {"steps": 0}})
+    assert str(err.value) == "settings.steps: must be >= 1; got 0"
+    with pytest.raises(InvalidParameterError) as err:
+        parse_sweep({**data, "settings": {"method": "fem"}})
+    assert str(err.value) == "settings.method: must be 'rod' or 'closed_form'; got 'fem'"

@@ -42,7 +42,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
-from rotomorph.io.designfile import ContactModel
+from rotomorph.io.designfile import ContactModel, schema_error
 
 __all__ = ["TargetFile", "curve_points", "load_target", "parse_target"]
 
@@ -237,14 +237,13 @@ def _rotate(vectors: FloatArray, axis: FloatArray, angle: float) -> FloatArray:
 
 
 def _format(err: Any) -> tuple[str, str]:
-    loc = ".".join(str(p) for p in err["loc"]) or "<target>"
-    if err["type"] == "extra_forbidden":  # as the design and sweep files say it
+    loc, msg = schema_error(err)  # the design file's wording
+    loc = loc.replace("<design>", "<target>")
+    if err["type"] == "extra_forbidden":
         return loc, "unknown key; remove it or check its spelling (see docs/inverse.md)"
     if err["type"] == "missing" and loc == "kind":
         return loc, "is required; add kind = 'curve', 'dome', 'saddle' or 'height_map'"
-    if err["type"] == "missing":
-        return loc, "is required"
-    return loc, err["msg"].removeprefix("Value error, ")
+    return loc, msg
 
 
 def parse_target(data: dict[str, Any]) -> TargetFile:

@@ -101,6 +101,7 @@ __all__ = [
     "parse_design",
     "parse_design_bytes",
     "save_design",
+    "schema_error",
     "with_spacing",
 ]
 
@@ -732,7 +733,10 @@ def _printable(text: str) -> str:
     return text if text.isprintable() else text.encode("unicode_escape").decode("ascii")
 
 
-def _format_error(err: ErrorDetails) -> tuple[str, str]:
+def schema_error(err: ErrorDetails) -> tuple[str, str]:
+    """``(field, message)`` of one pydantic error, in the words of every rotomorph error
+    (``filaments[0].speed``, ``must be >= 0.01 mm/s; got -2.0``); sweep and target files use it
+    too."""
     loc: list[str] = []
     for part in err["loc"]:
         if isinstance(part, int):
@@ -787,7 +791,7 @@ def parse_design(data: dict[str, Any]) -> Design:
     try:
         return Design.model_validate(data)
     except ValidationError as exc:
-        errors = _same_fault_once([_format_error(e) for e in exc.errors()])
+        errors = _same_fault_once([schema_error(e) for e in exc.errors()])
         field, msg = errors[0]
         more = (
             "" if len(errors) == 1 else "; also " + "; ".join(f"{f}: {m}" for f, m in errors[1:4])

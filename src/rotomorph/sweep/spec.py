@@ -41,7 +41,7 @@ from typing import Annotated, Any, Final, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from rotomorph.errors import InvalidDesignError, InvalidParameterError
-from rotomorph.io.designfile import Design, parse_design
+from rotomorph.io.designfile import Design, parse_design, schema_error
 from rotomorph.io.machine import MachineProfile, load_machine_profile
 from rotomorph.sweep.paths import check_path, parse_path
 
@@ -275,13 +275,10 @@ class Sweep(_Model):
 
 
 def _format(err: Any) -> str:
-    loc = ""
-    for part in err["loc"]:
-        loc += f"[{part}]" if isinstance(part, int) else ("." if loc else "") + str(part)
-    msg = err["msg"].removeprefix("Value error, ")
+    field, msg = schema_error(err)  # the design file's wording
     if err["type"] == "extra_forbidden":
         msg = "unknown key; remove it or check its spelling (see sweep_schema())"
-    return f"{loc or '<sweep>'}: {msg}"
+    return f"{field.replace('<design>', '<sweep>')}: {msg}"
 
 
 def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
