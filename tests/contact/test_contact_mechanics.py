@@ -144,6 +144,12 @@ def test_step_bound_stops_a_tunnelling_step():
     assert pot.clearance(x + t * dx) > 1.0
     assert not pot.path_is_free(x, x + dx)
     assert pot.path_is_free(x, x + 0.5 * t * dx)
+    # a node falling onto the floor moves linearly in height: its bound is exactly the close
+    # fraction of its time of impact, (1.0 - r) / 3
+    net = Network([[-1, 0, 1.0], [1, 0, 1.0]], [[0, 1]])
+    pot = ContactPotential(Contact(radius=0.5, obstacles=(Floor(),), activation_distance=0.01), net)
+    dx = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -3.0]])
+    assert pot.step_bound(net.nodes, dx) == pytest.approx(0.9 * 0.5 / 3.0, rel=1e-12)
 
 
 def test_obstacle_constructors_check_units_and_shapes():
