@@ -98,6 +98,34 @@ def test_rows_take_the_most_halvings_and_the_summed_time_of_their_sub_steps():
     np.testing.assert_allclose(wall, [0.0, 1.0, 0.5, 0.25, 2.0])
 
 
+def test_a_halved_ramp_step_shows_in_its_row(monkeypatch):
+    """A ramp step that fails once and succeeds halved: its row records one halving (and the
+    midpoint's iterations), the others none; the sub-stepped-ramp test above sees only rows
+    without halvings, where any aggregation (or none) gives zeros."""
+    real = heating.continuation
+
+    def first_try_fails(solve, params, initial, **kw):  # type: ignore[no-untyped-def]
+        failed: list[float] = []
+
+        def flaky(p, state):  # type: ignore[no-untyped-def]
+            if p == params[1] and not failed:
+                failed.append(p)
+                raise ConvergenceError("injected")
+            return solve(p, state)
+
+        return real(flaky, params, initial, **kw)
+
+    plain = heat_lattice(_small(), steps=2)
+    monkeypatch.setattr(heating, "continuation", first_try_fails)
+    res = heat_lattice(_small(), steps=2)
+    assert plain.halvings.tolist() == [0, 0, 0] and res.halvings.tolist() == [0, 0, 1]
+    assert res.iterations[1] == plain.iterations[1]
+    assert res.iterations[2] > plain.iterations[2]  # the midpoint's solve counts toward it
+    # the same end state (free lattices drift rigidly by a step's history)
+    assert shape_distance(res.positions[-1], plain.positions[-1]) < 1e-4  # mm
+    assert res.energy[-1] == pytest.approx(plain.energy[-1], rel=1e-9)
+
+
 def test_path_check_records_both_ramps():
     plain = heat_lattice(_small(), steps=2)
     res = heat_lattice(_small(), steps=2, path_check=2)
