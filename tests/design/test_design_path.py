@@ -63,7 +63,7 @@ def test_transforms():
         (np.zeros((0, 3)), "empty"),
         ([[0, 0, 0]], "at least 2"),
         ([[0, 0, 0], [1, np.nan, 0]], "finite; vertex 1"),
-        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], "vertices 1 and 2 are repeated"),
+        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], r"vertices 1 and 2 \(1, 0, 0\) mm are repeated"),
     ],
 )
 def test_invalid_paths_name_the_field(points, match):
@@ -79,3 +79,31 @@ def test_invalid_segments():
         Sinusoid(1.0, 0.0)
     with pytest.raises(InvalidDesignError, match="segments"):
         Path.from_segments([])
+
+
+def test_polyline_edges_are_split_at_the_vertex_spacing_keeping_its_corners():
+    corner = [[0.0, 0, 0], [1.0, 0, 0], [1.0, 0.25, 0]]
+    path = Path.from_segments([Polyline(corner)], spacing=0.1)
+    assert len(path.points) == 10 + 3 + 1  # 1 mm in 10 edges, 0.25 mm in 3
+    # the given vertices stay vertices (the corner is kept), the pieces are equal
+    for p in corner:
+        assert np.min(np.linalg.norm(path.points - p, axis=1)) < 1e-12
+    lengths = np.linalg.norm(np.diff(path.points, axis=0), axis=1)
+    np.testing.assert_allclose(lengths[:10], 0.1, rtol=1e-12)
+    np.testing.assert_allclose(lengths[10:], 0.25 / 3, rtol=1e-12)
+    as_given = Path.from_segments([Polyline(corner, resample=False)], spacing=0.1)
+    np.testing.assert_array_equal(as_given.points, corner)
+
+
+def test_a_polyline_design_is_resolved_at_its_spacing():
+    """A two-point polyline filament is a rod at the filament's spacing (it was one edge, so
+    refused as too short to bend, whatever the spacing), and the size estimate counts it."""
+    from rotomorph.io.designfile import parse_design
+
+    fil = {"spacing": 0.5, "segments": [{"kind": "polyline", "points": [[0, 0, 0], [10, 0, 0]]}]}
+    design = parse_design({"schema_version": 1, "filaments": [fil]})
+    (f,) = design.filaments
+    assert len(f.to_program().points) == f.node_count() == 21
+    given = {**fil, "segments": [{**fil["segments"][0], "resample": False}]}
+    with pytest.raises(InvalidDesignError, match="vertices"):
+        parse_design({"schema_version": 1, "filaments": [given]})

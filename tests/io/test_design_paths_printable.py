@@ -26,19 +26,20 @@ LINE = {"kind": "line", "length": 5.0}
     [
         (
             [{"kind": "polyline", "points": [[0, 0, 0], [5, 0, 0], [0, 0, 0]]}],
-            "filaments[1]: segments[0]: turns back on itself at vertex 1 (a 180 deg turn)",
+            "filaments[1]: segments[0]: turns back on itself at vertex 10 (5, 0, 0) mm "
+            "(a 180 deg turn)",
         ),
         (
             [{"kind": "polyline", "points": [[0, 0, 0], [5, 0, 0], [0, 1e-4, 0]]}],
-            "filaments[1]: segments[0]: turns back on itself at vertex 1",
+            "filaments[1]: segments[0]: turns back on itself at vertex 10 (5, 0, 0) mm",
         ),
         (
             [LINE, {"kind": "polyline", "points": [[5, 0, 0], [1, 0, 0]]}],
-            "filaments[1]: segments[1]: turns back on itself at vertex 10",
+            "filaments[1]: segments[1]: turns back on itself at vertex 10 (5, 0, 0) mm",
         ),
         (
             [{"kind": "polyline", "points": [[0, 0, 0], [0, 0, 0], [5, 0, 0]]}],
-            "filaments[1]: segments[0]: vertices 0 and 1 are repeated",
+            "filaments[1]: segments[0]: vertices 0 and 1 (0, 0, 0) mm are repeated",
         ),
         (  # before: "segments[1].points: ..." without the filament
             [LINE, {"kind": "polyline", "points": [[6, 0, 0], [9, 0, 0]]}],

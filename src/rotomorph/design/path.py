@@ -17,6 +17,7 @@ Conventions
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Union
@@ -94,12 +95,16 @@ class Sinusoid:
 
 @dataclass(frozen=True)
 class Polyline:
-    """Explicit vertices ``(M, 3)`` in lab coordinates (mm), used as given (no resampling).
+    """Explicit vertices ``(M, 3)`` in lab coordinates (mm): straight edges between them.
 
     If it is not the first segment, its first vertex must coincide with the current end.
+    With ``resample`` (default) every edge longer than the path's vertex spacing is split into
+    equal parts no longer than it, like the other segments (the given vertices stay vertices,
+    so corners are kept); without it the vertices are used as given.
     """
 
     points: FloatArray
+    resample: bool = True
 
     def __post_init__(self) -> None:
         pts = np.array(self.points, dtype=float)
@@ -135,6 +140,11 @@ def _check_points(points: FloatArray, field: str = "Path.points") -> FloatArray:
     return pts
 
 
+def _at(p: FloatArray) -> str:
+    """A vertex's position for messages: ``(x, y, z) mm``."""
+    return "(" + ", ".join(f"{float(c):.4g}" for c in p) + ") mm"
+
+
 #: Largest turn (deg) at one vertex: a sharper one retraces the edge just printed.
 MAX_TURN_DEG = 179.0
 
@@ -148,8 +158,8 @@ def path_defect(points: FloatArray) -> tuple[int, str] | None:
 
     Examples
     --------
-    >>> path_defect(np.array([[0.0, 0, 0], [5, 0, 0], [0, 0, 0]]))[1][:50]
-    'turns back on itself at vertex 1 (a 180 deg turn):'
+    >>> path_defect(np.array([[0.0, 0, 0], [5, 0, 0], [0, 0, 0]]))[1][:56]
+    'turns back on itself at vertex 1 (5, 0, 0) mm (a 180 deg'
     """
     pts = np.asarray(points, dtype=float)
     edges = np.diff(pts, axis=0)
@@ -158,7 +168,9 @@ def path_defect(points: FloatArray) -> tuple[int, str] | None:
     rep = lengths <= 1e-9 * scale
     if rep.any():
         i = int(np.flatnonzero(rep)[0])
-        return i, f"vertices {i} and {i + 1} are repeated (zero-length edge); remove one"
+        return i, (
+            f"vertices {i} and {i + 1} {_at(pts[i])} are repeated (zero-length edge); remove one"
+        )
     unit = edges / lengths[:, None]
     cos = np.einsum("ij,ij->i", unit[:-1], unit[1:])
     back = np.flatnonzero(cos < np.cos(np.radians(MAX_TURN_DEG)))
@@ -166,7 +178,8 @@ def path_defect(points: FloatArray) -> tuple[int, str] | None:
         i = int(back[0]) + 1
         turn = float(np.degrees(np.arccos(np.clip(cos[i - 1], -1.0, 1.0))))
         return i, (
-            f"turns back on itself at vertex {i} (a {turn:.0f} deg turn): a filament cannot be "
+            f"turns back on itself at vertex {i} {_at(pts[i])} (a {turn:.0f} deg turn): a "
+            "filament cannot be "
             "printed back over itself; offset the return by at least a filament diameter"
         )
     return None
@@ -203,8 +216,19 @@ def _discretise(seg: Segment, start: FloatArray, heading: float, spacing: float)
         y = seg.amplitude * np.sin(k * x)
         return start + np.outer(x, [c, s, 0.0]) + np.outer(y, [-s, c, 0.0])
     if isinstance(seg, Polyline):
-        return np.array(seg.points, dtype=float)
+        return _polyline_vertices(np.array(seg.points, dtype=float), seg.resample, spacing)[1:]
     raise InvalidDesignError("segments", f"unknown segment type {type(seg).__name__}")
+
+
+def _polyline_vertices(pts: FloatArray, resample: bool, spacing: float) -> FloatArray:
+    """A polyline's vertices, each edge split into ``_count(length, spacing)`` equal parts."""
+    if not resample:
+        return pts
+    out = [pts[:1]]
+    for a, b in itertools.pairwise(pts):
+        m = _count(float(np.linalg.norm(b - a)), spacing)
+        out.append(a + np.outer(np.arange(1, m + 1) / m, b - a))
+    return np.concatenate(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -375,7 +399,7 @@ def chain_segments(
                     f"segments[{i}].points",
                     f"must start at the current end {cur.tolist()} mm; got {pts[0].tolist()}",
                 )
-            new = pts[1:]
+            new = _polyline_vertices(pts, seg.resample, spacing)[1:]
             d = pts[-1] - pts[-2]
             head = float(np.arctan2(d[1], d[0]))
         else:

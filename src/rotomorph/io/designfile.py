@@ -44,6 +44,7 @@ error is listed in ``docs/design-files.md``.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import math
 import re
@@ -236,6 +237,10 @@ class PolylineSegment(_Control):
     points: list[Vec3] = Field(
         min_length=2, max_length=MAX_NODES, description="lab coordinates (mm)"
     )
+    resample: bool = Field(
+        True,
+        description="split edges longer than the filament's spacing (false: vertices as given)",
+    )
 
 
 SegmentModel = Annotated[
@@ -332,7 +337,13 @@ class Filament(_Control, _Process):
         edges = 0
         for seg in self.segments:
             if seg.kind == "polyline":
-                edges += len(seg.points) - 1
+                if not seg.resample:
+                    edges += len(seg.points) - 1
+                    continue
+                edges += sum(
+                    segment_edges(math.dist(a, b), self.spacing)
+                    for a, b in itertools.pairwise(seg.points)
+                )
                 continue
             if seg.kind == "line":
                 length = seg.length
@@ -463,7 +474,7 @@ def _geometry(seg: Any) -> Any:
         return Arc(seg.radius, math.radians(seg.angle_deg))
     if seg.kind == "sinusoid":
         return Sinusoid(seg.amplitude, seg.wavelength, seg.periods)
-    return Polyline(np.array(seg.points))
+    return Polyline(np.array(seg.points), resample=seg.resample)
 
 
 class LatticeModel(_Process):
