@@ -24,8 +24,11 @@ Creeping: near a bifurcation the shift (or the convex Hessian) that makes an ind
 Hessian positive definite also masks its direction of negative curvature; whole steps then
 slide off the saddle along it by a few per cent per iteration, the residual never falling
 (hundreds of iterations). After ``creep_steps`` such steps each further whole step is tried
-at 2, 4, 8, ... times its length (within the objective's step bound) while the energy keeps
-falling with the Armijo condition: the same ray the creep follows, covered in one iteration.
+at 2, 4 and 8 times its length (:data:`MAX_EXTENSION`; within the objective's step bound)
+while the energy keeps falling with the Armijo condition: the ray the creep follows, covered up
+to 8 times faster. (Longer extensions, or leaving the saddle along its negative mode at the
+first creep, can carry a nearly neutral body much further: a free filament across two rods
+slid off them.)
 
 """
 
@@ -157,7 +160,7 @@ class NewtonOptions:
     keep_modes: bool = False
     stability_tol: float = 1e-12
     saddle_escapes: int = 10
-    creep_steps: int = 3
+    creep_steps: int = 5
 
     def __post_init__(self) -> None:
         if self.max_iterations < 1:
