@@ -7,11 +7,14 @@ of the finite-difference Jacobian of the gradient and with second differences of
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from _rod_builders import anisotropic_model, displaced_objective, random_chain
 
 from rotomorph.design.network import Network
+from rotomorph.rod.model import Model
 from rotomorph.solve.linalg import BandedMatrix
 
 
@@ -106,6 +109,49 @@ def test_hessian_second_differences_and_taylor_slope(rng):
     s2 = np.polyfit(np.log(hs), np.log(r2), 1)[0]
     assert s1 == pytest.approx(2.0, abs=0.1)
     assert s2 == pytest.approx(3.0, abs=0.2)
+
+
+@pytest.mark.parametrize("which", [0, 1], ids=["chain", "junctions"])
+def test_gauss_newton_hessian_is_the_exact_one_at_a_stress_free_state(rng, which):
+    """Where every strain is at its natural value the second-derivative terms of the strains
+    carry zero weight: Gauss-Newton and exact Hessians coincide, term by term (B1, B2, C, EA
+    all different per edge). Positive semidefiniteness alone holds for any truncation."""
+    from rotomorph.solve.loads import Loads, Supports
+    from rotomorph.solve.objective import RodObjective
+
+    net = _networks(rng)[which]
+    ne = net.n_edges
+    model = Model(
+        net,
+        bending_stiffness1=rng.uniform(0.5, 2.0, ne),
+        bending_stiffness2=rng.uniform(2.0, 4.0, ne),
+        twist_stiffness=rng.uniform(0.3, 1.0, ne),
+        axial_stiffness=rng.uniform(20.0, 60.0, ne),
+    )  # natural values: the printed ones
+    obj = RodObjective(model, model.reference_state(), Supports(), Loads())
+    q = obj.vector()
+    exact = _dense(obj.evaluate(q, True, True)[2])
+    gn = _dense(obj.convex_hessian(q))
+    assert np.abs(exact).max() > 1.0
+    np.testing.assert_allclose(gn, exact, rtol=0, atol=1e-10 * np.abs(exact).max())
+    if which == 0:
+        # a straight chain stretched by 10 %: bending and twist stay natural, and stretching
+        # in tension keeps its transverse (string) stiffness: still the exact Hessian
+        s = np.cumsum(rng.uniform(0.5, 1.5, 7))
+        straight = Model.chain(
+            np.c_[s, 0 * s, 0 * s],
+            bending_stiffness1=1.0,
+            bending_stiffness2=3.0,
+            twist_stiffness=0.7,
+            axial_stiffness=40.0,
+        )
+        ref = straight.reference_state()
+        stretched = replace(ref, positions=1.1 * ref.positions)
+        obj = RodObjective(straight, stretched, Supports(), Loads())
+        q = obj.vector()
+        exact = _dense(obj.evaluate(q, True, True)[2])
+        np.testing.assert_allclose(_dense(obj.convex_hessian(q)), exact, rtol=0,
+                                   atol=1e-10 * np.abs(exact).max())  # fmt: skip
 
 
 def test_gauss_newton_hessian_is_positive_semidefinite(rng):
