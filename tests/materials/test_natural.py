@@ -87,6 +87,10 @@ def test_rotated_filament_matches_closed_form_helix() -> None:
     ref = filament_shapes(MODEL, [0.25], 0.5)[0]
     assert shape.end_to_end_ratio == pytest.approx(ref.end_to_end_ratio, rel=1e-3)
     assert shape.label == ref.label
+    # the same helix, not its mirror image: the closed form winds the director helix with the
+    # design layer's sense, as the rod's natural field does
+    assert shape.torsion == pytest.approx(ref.torsion, rel=1e-3)
+    assert shape.curvature == pytest.approx(ref.curvature, rel=1e-3)
 
 
 def test_opposite_rotation_convention_is_reported(caplog: pytest.LogCaptureFixture) -> None:

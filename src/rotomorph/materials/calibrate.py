@@ -39,7 +39,7 @@ from rotomorph.materials.inference import (
 from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.measurements import MeasuredTable, load_table
 from rotomorph.materials.morphology import HelixShape, free_helix
-from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.natural import DIRECTOR_HELIX_SENSE, FilamentModel
 from rotomorph.materials.process import EmpiricalThreshold
 
 #: Print speed of the paper's rotated filaments (Fig. 2F/G), mm/s.
@@ -97,7 +97,10 @@ def filament_shapes(
     """
     active, passive = _inks()
     section = model.section(active, passive, radius, active_fraction)
-    w = np.atleast_1d(np.asarray(omega_star, dtype=float))
+    # the director helix turns with DIRECTOR_HELIX_SENSE * omega* in the filament frame (the
+    # design layer's alpha = psi - alpha_n), so the helix has the handedness the rod solver gives
+    # the same print program
+    w = DIRECTOR_HELIX_SENSE * np.atleast_1d(np.asarray(omega_star, dtype=float))
     e_par, e_perp, eps_p = model.strains(np.full(len(w), speed), passive)
     eps_c, kappa, dtau = section.natural_strains(w, e_par, e_perp, eps_p)
     measure = model.strain_model.measure
