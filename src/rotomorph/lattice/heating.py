@@ -736,8 +736,9 @@ def _gaps_per_step(probes: dict[float, float], values: FloatArray) -> FloatArray
 
 #: Height of the lifted start of :func:`_lift_probe`, in lattice spacings l (0.5 mm for the
 #: paper's 5 mm cells, about a filament diameter): a start for the weightless buckling solve,
-#: whose flat state is unstable there, so any height leaves it (0.1 and 0.5 give the same end
-#: states of the paper's contracting, dome and saddle ramps, to the digits printed).
+#: whose flat state is unstable there, so any height leaves it. Which buckled state it reaches
+#: can depend on the height: on the 16-step contracting ramp 0.1 l and 0.2 l end in the same
+#: state, 0.3 l and 0.5 l in another one (A/A0 0.2796 against 0.2778).
 LIFT_PROBE_HEIGHT = 0.1
 
 
