@@ -346,7 +346,7 @@ def lattice_gravity(
     fluid_density
         Density of the bath (g/cm³); default the silicone oil of the bath-fluid table at
         25 °C (:func:`rotomorph.materials.bath.bath_density`: 0.97, PDMS fluid data sheets;
-        ``bath_density(temperature=175)`` ≈ 0.83 for the hot bath).
+        ``bath_density(temperature=175)`` ≈ 0.85 for the hot bath).
     density
         Filament density (g/cm³); default the mean of the lattice's two inks (materials table).
     """

@@ -88,7 +88,7 @@ SINUSOID_DESIGN: dict[str, float] = {
 }
 #: Flip length (mm) of the counted sinusoid predictions: ideal step flips, the limit of a fast
 #: nozzle turn. The paper gives no flip length; the printable 0.5 mm flips are shown next to it
-#: (not counted): their ratio converges only as O(h) in the flip zones (0.27 / 0.30 / 0.32 at
+#: (not counted): their ratio converges only as O(h) in the flip zones (0.31 / 0.36 / 0.37 at
 #: h = 0.1 / 0.05 / 0.025 mm for the contracting one), so it cannot be reported to 1 %.
 IDEAL_FLIP = 0.0
 
