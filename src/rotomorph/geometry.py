@@ -242,3 +242,12 @@ def polyline_strains(
     k1, k2, tw = pair_strains(e[:-1], e[1:], directors[:-1], directors[1:])
     lengths = np.linalg.norm(e, axis=-1)
     return k1, k2, tw, 0.5 * (lengths[:-1] + lengths[1:])
+
+
+def best_rotation(points: FloatArray, target: FloatArray) -> FloatArray:
+    """The proper rotation ``R`` (3 x 3) minimising ``sum_i |R p_i - q_i|^2`` for centred
+    ``(N, 3)`` point sets ``p`` (``points``) and ``q`` (``target``) with corresponding rows
+    (Kabsch, *Acta Cryst.* A32, 922, 1976); apply it as ``p @ R.T``."""
+    u, _, vt = np.linalg.svd(np.asarray(points, float).T @ np.asarray(target, float))
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    return np.asarray(vt.T @ np.diag([1.0, 1.0, d]) @ u.T)

@@ -185,3 +185,17 @@ def test_path_check_with_friction_is_refused():
     with pytest.raises(InvalidParameterError, match="path_check"):
         heat_lattice(lat, steps=1, floor=True, gravity=lattice_gravity(lat), friction=0.3,
                      path_check=2)  # fmt: skip
+
+
+def test_best_rotation_recovers_a_rotation_and_never_reflects():
+    from scipy.spatial.transform import Rotation
+
+    from rotomorph.geometry import best_rotation
+
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(20, 3))
+    p -= p.mean(axis=0)
+    r = Rotation.from_rotvec([0.3, -1.1, 0.7]).as_matrix()
+    np.testing.assert_allclose(best_rotation(p, p @ r.T), r, atol=1e-12)
+    mirrored = best_rotation(p, p * [1.0, 1.0, -1.0])  # no rotation maps p onto its mirror
+    assert np.linalg.det(mirrored) == pytest.approx(1.0)

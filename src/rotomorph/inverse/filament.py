@@ -30,6 +30,7 @@ import numpy as np
 from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidDesignError
+from rotomorph.geometry import best_rotation
 from rotomorph.inverse.curve import CurveGeometry, curve_geometry, resample, self_intersection
 from rotomorph.inverse.response import ResponseTable, cached_response_table
 from rotomorph.materials.natural import FilamentModel, natural_field
@@ -47,11 +48,7 @@ def kabsch(points: FloatArray, target: FloatArray) -> FloatArray:
     p = np.asarray(points, float)
     q = np.asarray(target, float)
     pc, qc = p.mean(axis=0), q.mean(axis=0)
-    h = (p - pc).T @ (q - qc)
-    u, _, vt = np.linalg.svd(h)
-    d = np.sign(np.linalg.det(vt.T @ u.T))
-    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-    return (p - pc) @ r.T + qc
+    return (p - pc) @ best_rotation(p - pc, q - qc).T + qc
 
 
 def aligned_rms(points: FloatArray, target: FloatArray) -> float:

@@ -49,6 +49,7 @@ from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.contact import Contact, Floor
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidDesignError, InvalidParameterError
+from rotomorph.geometry import best_rotation
 from rotomorph.inverse.adjoint import NotAMinimumError, adjoint
 from rotomorph.inverse.blend import LatticeBlend, lattice_blend, with_settings
 from rotomorph.lattice.actuation import Actuation
@@ -287,9 +288,7 @@ def shape_misfit(
     x = np.asarray(positions, dtype=float)
     y = np.asarray(target, dtype=float)
     xc, yc = x - x.mean(axis=0), y - y.mean(axis=0)
-    u, _, vt = np.linalg.svd(xc.T @ yc)
-    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-    rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    rot = best_rotation(xc, yc)
     r = xc @ rot.T - yc
     n = len(x)
     j = 0.5 * float(np.sum(r * r)) / (n * size * size)

@@ -20,6 +20,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
+from rotomorph.geometry import best_rotation
 
 __all__ = [
     "ENERGY_TIE",
@@ -133,10 +134,7 @@ def shape_distance(a: FloatArray, b: FloatArray) -> float:
     alignment of ``b`` onto ``a`` (least squares; Kabsch, Acta Cryst. A32, 922 (1976))."""
     pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     ca, cb = pa - pa.mean(axis=0), pb - pb.mean(axis=0)
-    u, _, vt = np.linalg.svd(cb.T @ ca)
-    d = np.sign(np.linalg.det(u @ vt))
-    rot = u @ np.diag([1.0, 1.0, d]) @ vt
-    return float(np.linalg.norm(cb @ rot - ca, axis=1).max())
+    return float(np.linalg.norm(cb @ best_rotation(cb, ca).T - ca, axis=1).max())
 
 
 def choose_end(
