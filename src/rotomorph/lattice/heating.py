@@ -570,14 +570,10 @@ def heat_lattice(
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
 
     probes: dict[float, float] = {}  # parameter -> energy of the lifted branch minus resting
-    announced: list[bool] = []  # the set-up line is logged once, not again for a path check
 
     def solve(p: float, state: State) -> StaticResult:
         phase_log.info("natural field (%s) at %g", act.name, p)
         model = act.natural(lm, p)
-        if not announced:
-            phase_log.info("set-up: Hessian sparsity pattern and ordering; then Newton solves")
-            announced.append(True)
         try:
             loads = loads_at(p)
             res = solve_static(model, sup, loads, initial=state, options=options, contact=settings)
@@ -600,6 +596,7 @@ def heat_lattice(
                 res = lifted
         return res
 
+    phase_log.info("set-up: Hessian sparsity pattern and ordering with the first solve")
     path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
     finals = path.results
     checked: PathCheck | None = None

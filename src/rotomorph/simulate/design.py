@@ -214,11 +214,9 @@ def _simulate_filaments(
     sim = filaments_simulation(
         sims, design.model_dump(mode="json"), temperatures=(start_temperature, temperature)
     )
-    record = surroundings_record(design.contact, temperature, along_ramp=True)
+    record = surroundings_record(design.contact, temperature, along_ramp=True, lattice=False)
     if record is None:
         return sim
-    for lattice_only in ("branch", "path_check"):  # not applied to filaments: not recorded
-        record.pop(lattice_only, None)
     return replace(sim, metadata={**sim.metadata, "contact": record})
 
 

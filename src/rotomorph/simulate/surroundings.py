@@ -97,11 +97,12 @@ def lattice_surroundings(
 
 
 def surroundings_record(
-    contact: Any, temperature: float, *, along_ramp: bool = False
+    contact: Any, temperature: float, *, along_ramp: bool = False, lattice: bool = True
 ) -> dict[str, Any] | None:
     """What the run assumed about its surroundings, for ``summary.json`` and the HDF5 file;
     ``along_ramp``: the buoyancy followed the bath density over the temperature ramp (the
-    density recorded is the one at ``temperature``, the end of the ramp)."""
+    density recorded is the one at ``temperature``, the end of the ramp); ``lattice``: the
+    lattice-only choices (``branch``, ``path_check``) were applied and are recorded."""
     if contact is None:
         return None
     record: dict[str, Any] = {
@@ -109,9 +110,9 @@ def surroundings_record(
         "floor": bool(contact.floor),
         "gravity": bool(contact.gravity),
         "friction": float(contact.friction),
-        "branch": str(contact.branch),
-        "path_check": int(contact.path_check),
     }
+    if lattice:
+        record.update(branch=str(contact.branch), path_check=int(contact.path_check))
     if contact.gravity:
         fluid = bath_fluids()[contact.bath]
         record.update(
