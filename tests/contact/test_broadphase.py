@@ -59,3 +59,77 @@ def test_no_near_pair_is_left_out(seed):
     path_near = {(a, b) for a, b, d in zip(i, j, swept, strict=True) if d < reach}
     assert len(path_near) > len(near)
     assert path_near <= _found(pot._build_candidates(x, 0.0, step=dx), pot)
+
+
+def _grid(rng: np.random.Generator) -> tuple[Network, np.ndarray]:
+    """Two crossing layers of four wavy filaments (12 nodes each, 0.8 mm apart, layers 0.5 mm
+    apart), printed 120 mm apart in z (no pair fused): (network, positions)."""
+    s = np.linspace(0.0, 5.0, 12)
+    lines, edges = [], []
+    for c in range(8):
+        off = 0.8 * (c % 4)
+        wave = 0.1 * np.sin(2.0 * s + rng.uniform(0.0, 2.0 * np.pi))
+        if c < 4:
+            pts = np.stack([s, off + wave, np.zeros(12)], axis=1)
+        else:
+            pts = np.stack([off + 0.4 + wave, s, np.full(12, 0.5)], axis=1)
+        lines.append(pts + rng.normal(scale=0.01, size=pts.shape))
+        edges.append(12 * c + np.stack([np.arange(11), np.arange(1, 12)], axis=1))
+    x = np.vstack(lines)
+    lift = np.repeat(120.0 * np.arange(8), 12)[:, None] * [0.0, 0.0, 1.0]
+    return Network(x + lift, np.vstack(edges)), np.ascontiguousarray(x)
+
+
+def _shift(rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
+    """Each filament translated by its own random vector of length up to ``scale`` (pairs of
+    filaments close at up to twice that), plus a small jitter per node."""
+    shift = rng.normal(size=(8, 3))
+    shift *= rng.uniform(0.0, scale, (8, 1)) / np.linalg.norm(shift, axis=1, keepdims=True)
+    return np.repeat(shift, 12, axis=0) + rng.normal(scale=0.05 * scale, size=shape)
+
+
+def _sets(pairs: np.ndarray) -> set[tuple[int, ...]]:
+    return {tuple(p) for p in pairs.tolist()}
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_reused_candidates_give_the_pairs_of_a_fresh_broad_phase(seed):
+    """A random walk of two crossing layers of filaments, kept just clear of contact, with the
+    padded candidate set reused many times (a Verlet list): every pair within reach is
+    evaluated (the same active pairs and energy as a fresh broad phase at each configuration),
+    the step bound's pairs picked out of the reused set equal a fresh swept broad phase's for
+    steps inside and beyond what the set covers, and the step bounds are identical."""
+    rng = np.random.default_rng(seed)
+    net, base = _grid(rng)
+    contact = Contact(radius=0.2)
+    pot = ContactPotential(contact, net)
+    judge = ContactPotential(contact, net)  # admissibility checks, apart from pot's reuse
+    pad = pot._pad
+    x = base
+    reuses = active = steps_reused = swept = 0
+    for _ in range(150):
+        step = 0.1 * (base - x) + _shift(rng, x.shape, 0.5 * pad)
+        while judge.clearance(x + step) <= 1.0:  # back off until clear of contact
+            step *= 0.5
+        x = np.ascontiguousarray(x + step)
+        before = pot._cache
+        e, g, h = pot.evaluate_blocks(x, True, 1)
+        reuses += before is not None and pot._cache is before
+        fresh = ContactPotential(contact, net)
+        fresh._pad = 0.0  # a broad phase at x itself
+        e0, g0, h0 = fresh.evaluate_blocks(x, True, 1)
+        assert np.isfinite(e0) and e == pytest.approx(e0, rel=1e-12, abs=1e-300)
+        np.testing.assert_allclose(g, g0, rtol=1e-12, atol=1e-12 * np.abs(g0).max())
+        assert _sets(h.quads) == _sets(h0.quads)
+        active += len(h.quads)
+        for scale in (0.05, 0.2, 0.5, 2.0):  # steps from x, some beyond the reused set
+            dx = _shift(rng, x.shape, scale * pad)
+            steps_reused += pot._cache.covers(x, x + dx)
+            seg, node = pot._swept_pairs(x, dx)
+            seg0, node0 = pot._self_pairs(x, x + dx, 0.0)
+            assert _sets(seg) == _sets(seg0) and len(seg) == len(seg0)
+            assert _sets(node) == _sets(node0) and len(node) == len(node0)
+            swept += len(seg0) + len(node0)
+            assert pot.step_bound(x, dx) == ContactPotential(contact, net).step_bound(x, dx)
+    assert 50 < reuses < 140  # both reuse and fresh broad phases, many times
+    assert active > 100 and steps_reused > 200 and swept > 5000

@@ -17,8 +17,9 @@ import numpy as np
 from numba import njit
 
 from rotomorph._typing import FloatArray, IntArray
+from rotomorph.contact.distance import BOUND_MARGIN
 
-__all__ = ["near_pairs"]
+__all__ = ["near_pairs", "near_subset", "within_reach"]
 
 
 @njit(cache=True)
@@ -60,7 +61,9 @@ def _grow(buf, count):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma: no cover
+def _boxes(x0, x1, edges, seg_share, node_share):  # pragma: no cover - compiled
+    """Boxes ``lo``, ``hi`` (M, 3) and shares (M,) of the segments, then the nodes, over the
+    positions ``x0`` and ``x1``, and the axis along which their lower corners spread most."""
     ne = edges.shape[0]
     nn = x0.shape[0]
     m = ne + nn
@@ -78,13 +81,36 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
             lo[ne + n, k] = min(x0[n, k], x1[n, k])
             hi[ne + n, k] = max(x0[n, k], x1[n, k])
         share[ne + n] = node_share[n]
-    # sweep along the axis of widest spread
     axis = 0
     widest = -1.0
     for k in range(3):
         w = lo[:, k].max() - lo[:, k].min()
         if w > widest:
             widest, axis = w, k
+    return lo, hi, share, axis
+
+
+@njit(cache=True)
+def _boxes_near(lo, hi, share, i, j):  # pragma: no cover - compiled
+    """Whether boxes ``i`` and ``j`` (rows of ``lo``, ``hi``) lie closer than the sum of their
+    shares: a gap along one axis of at least that rejects the pair (then the squared gap is
+    too). Indices, not row views: a view per call costs more than the test."""
+    reach = share[i] + share[j]
+    g2 = 0.0
+    for k in range(3):
+        g = max(lo[j, k] - hi[i, k], lo[i, k] - hi[j, k], 0.0)
+        if g >= reach:
+            return False
+        g2 += g * g
+    return g2 < reach * reach
+
+
+@njit(cache=True)
+def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma: no cover
+    ne = edges.shape[0]
+    lo, hi, share, axis = _boxes(x0, x1, edges, seg_share, node_share)
+    m = share.shape[0]
+    # sweep along the axis of widest spread
     start = lo[:, axis] - share
     order = np.argsort(start)
     ptr = _key_rows(keys, ne)
@@ -114,17 +140,7 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
             j = order[jj]
             if i_node and j >= ne:
                 continue  # node against node: carried by the segments
-            reach = share_s[ii] + share_s[jj]
-            # a gap along one axis of at least the reach rejects the pair (then g2 >= reach^2)
-            g2 = 0.0
-            far = False
-            for k in range(3):
-                g = max(lo_s[jj, k] - hi_s[ii, k], lo_s[ii, k] - hi_s[jj, k], 0.0)
-                if g >= reach:
-                    far = True
-                    break
-                g2 += g * g
-            if far or g2 >= reach * reach:
+            if not _boxes_near(lo_s, hi_s, share_s, ii, jj):
                 continue
             if not i_node and j < ne:
                 if not _excluded_in_row(keys, ptr, i, j, ne):
@@ -146,6 +162,30 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
                 node[nq, 1] = e
                 nq += 1
     return seg[:ns].copy(), node[:nq].copy()
+
+
+@njit(cache=True)
+def _in_window(lo, hi, share, i, j, axis):  # pragma: no cover - compiled
+    """Whether the sweep of :func:`_near_pairs` compares boxes ``i`` and ``j``: the later
+    start along ``axis`` is not past the end of the box that starts first."""
+    start_i = lo[i, axis] - share[i]
+    start_j = lo[j, axis] - share[j]
+    return start_j <= hi[i, axis] + share[i] and start_i <= hi[j, axis] + share[j]
+
+
+@njit(cache=True)
+def _near_subset(x0, x1, edges, seg_share, node_share, seg, node):  # pragma: no cover
+    ne = edges.shape[0]
+    lo, hi, share, axis = _boxes(x0, x1, edges, seg_share, node_share)
+    keep_seg = np.zeros(seg.shape[0], dtype=np.bool_)
+    for p in range(seg.shape[0]):
+        a, b = seg[p, 0], seg[p, 1]
+        keep_seg[p] = _in_window(lo, hi, share, a, b, axis) and _boxes_near(lo, hi, share, a, b)
+    keep_node = np.zeros(node.shape[0], dtype=np.bool_)
+    for p in range(node.shape[0]):
+        a, b = ne + node[p, 0], node[p, 1]
+        keep_node[p] = _in_window(lo, hi, share, a, b, axis) and _boxes_near(lo, hi, share, a, b)
+    return keep_seg, keep_node
 
 
 def near_pairs(
@@ -189,3 +229,86 @@ def near_pairs(
         np.ascontiguousarray(excluded, dtype=np.int64),
     )
     return seg, node
+
+
+def near_subset(
+    x0: FloatArray,
+    x1: FloatArray,
+    edges: IntArray,
+    seg_share: FloatArray,
+    node_share: FloatArray,
+    pairs: tuple[IntArray, IntArray],
+) -> tuple[IntArray, IntArray]:
+    """The pairs among ``pairs`` that :func:`near_pairs` proposes on ``x0 -> x1`` with these
+    shares: the same box tests in the same floating-point operations, so when ``pairs`` holds
+    every pair that :func:`near_pairs` would propose (e.g. a broad phase with larger shares
+    around positions close enough), the result is exactly its set (in the order of ``pairs``).
+
+    Parameters
+    ----------
+    x0, x1, edges, seg_share, node_share
+        As for :func:`near_pairs`.
+    pairs
+        Segment pairs ``(P, 2)`` and node–segment pairs ``(Q, 2)`` from an earlier broad phase
+        (their exclusions already applied).
+
+    Returns
+    -------
+    the segment pairs and node–segment pairs kept, in their order in ``pairs``.
+    """
+    seg, node = pairs
+    keep_seg, keep_node = _near_subset(
+        np.ascontiguousarray(x0, dtype=float),
+        np.ascontiguousarray(x1, dtype=float),
+        np.ascontiguousarray(edges, dtype=np.int64),
+        np.ascontiguousarray(seg_share, dtype=float),
+        np.ascontiguousarray(node_share, dtype=float),
+        np.ascontiguousarray(seg, dtype=np.int64).reshape(-1, 2),
+        np.ascontiguousarray(node, dtype=np.int64).reshape(-1, 2),
+    )
+    return seg[keep_seg], node[keep_node]
+
+
+@njit(cache=True)
+def _within_reach(quads, dist, move, reach):  # pragma: no cover - compiled
+    keep = np.empty(quads.shape[0], dtype=np.int64)
+    n = 0
+    for p in range(quads.shape[0]):
+        lower = (
+            dist[p]
+            - max(move[quads[p, 0]], move[quads[p, 1]])
+            - max(move[quads[p, 2]], move[quads[p, 3]])
+        )
+        if lower <= reach[p] * (1.0 + BOUND_MARGIN):
+            keep[n] = p
+            n += 1
+    return keep[:n].copy()
+
+
+def within_reach(
+    quads: IntArray, dist: FloatArray, move: FloatArray, reach: FloatArray
+) -> IntArray:
+    """Indices (ascending) of the pairs ``quads`` that may now be closer than ``reach``.
+
+    A point of a segment is a convex combination of its end nodes, so it has moved at most the
+    larger of their motions: a pair's distance is now at least its distance ``dist`` at the
+    earlier positions less the largest motion of each side. Pairs whose lower bound clears
+    ``reach`` by the relative ``BOUND_MARGIN`` (far above round-off) are left out.
+
+    Parameters
+    ----------
+    quads
+        Pairs ``(P, 4)``: node indices ``p0, p1, q0, q1`` (a repeated index: a point).
+    dist
+        Their centre-line distances at the earlier positions ``(P,)`` (mm).
+    move
+        Each node's motion since ``(M,)`` (mm; 0 for fixed obstacle points).
+    reach
+        Distance below which a pair counts ``(P,)`` (mm).
+    """
+    return _within_reach(  # type: ignore[no-any-return]
+        np.ascontiguousarray(quads, dtype=np.int64),
+        np.ascontiguousarray(dist, dtype=float),
+        np.ascontiguousarray(move, dtype=float),
+        np.ascontiguousarray(reach, dtype=float),
+    )

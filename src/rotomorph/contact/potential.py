@@ -25,7 +25,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.barrier import barrier, pair_barrier, plane_barrier
-from rotomorph.contact.broadphase import near_pairs
+from rotomorph.contact.broadphase import near_pairs, near_subset, within_reach
 from rotomorph.contact.ccd import pair_step_bound, plane_step_bound
 from rotomorph.contact.distance import closest_parameters, pair_distances
 from rotomorph.contact.exclusion import excluded_pairs
@@ -51,6 +51,7 @@ SWEPT_SLACK = 0.25
 
 
 _NO_INT = np.zeros(0, dtype=np.int64)
+_NO_PAIRS = np.zeros((0, 2), dtype=np.int64)
 
 
 class InfeasibleContactError(InvalidParameterError):
@@ -160,6 +161,34 @@ class _Candidates:
 
 
 @dataclass(frozen=True, eq=False)
+class _Reuse:
+    """A padded candidate set kept for reuse (a Verlet list), found at ``x`` with margin
+    ``pad``."""
+
+    x: FloatArray  # (N, 3) positions it was found at
+    pad: float  # margin (mm)
+    cand: _Candidates
+    near: tuple[IntArray, IntArray]  # the broad phase's segment and node–segment pairs
+    dist: FloatArray  # centre-line distance of every candidate pair at x (mm)
+
+    def covers(self, x0: FloatArray, x1: FloatArray) -> bool:
+        """Whether :attr:`near` holds every pair that a broad phase without margin proposes on
+        the straight step ``x0 -> x1``.
+
+        Every coordinate of ``x0`` and ``x1`` lies within ``δ_k`` (per axis ``k``) of its
+        node's coordinate in :attr:`x`, so each box over the step lies within the box at
+        :attr:`x` grown by ``δ`` per axis and the Euclidean gap of two such boxes is at least
+        the gap at :attr:`x` less ``2 |δ|``. With ``2 |δ|`` below the pad, a pair the step's
+        broad phase proposes (gap below the sum of its shares) was proposed at :attr:`x`
+        (gap below the shares plus the pad); a relative slack of 1e-6 covers round-off.
+        """
+        if x0.shape != self.x.shape or len(x0) == 0:
+            return False
+        delta = np.maximum(np.abs(x0 - self.x), np.abs(x1 - self.x)).max(axis=0)
+        return bool(2.0 * float(np.sqrt(delta @ delta)) <= (1.0 - 1e-6) * self.pad)
+
+
+@dataclass(frozen=True, eq=False)
 class HessianBlocks:
     """The contact Hessian as local blocks on node coordinates ``3 i + k``.
 
@@ -256,7 +285,7 @@ class ContactPotential:
         self._dmin_max = 2.0 * float(self.radius.max())
         self._lag: FrictionLag | None = None
         # broad-phase cache: reference positions, padded margin, candidates found there
-        self._cache: tuple[FloatArray, float, _Candidates] | None = None
+        self._cache: _Reuse | None = None
         # the last step bound's start, end and candidates (reused by path_is_free)
         self._swept: tuple[FloatArray, FloatArray, _Candidates] | None = None
         self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
@@ -333,22 +362,66 @@ class ContactPotential:
         two largest node motions), so the line-search trials and the accepted iterate of a
         Newton step share one broad phase.
         """
+        return self._reused(x, margin)[0].cand
+
+    def _reused(self, x: FloatArray, margin: float = 0.0) -> tuple[_Reuse, FloatArray | None]:
+        """The reused candidate set of :meth:`candidates` and each node's motion since it was
+        found (mm; None when found here)."""
         cache = self._cache
-        if cache is not None and cache[0].shape == x.shape:
-            move = float(np.sqrt(((x - cache[0]) ** 2).sum(axis=1).max())) if len(x) else 0.0
-            if 2.0 * move + margin <= cache[1]:
-                return cache[2]
+        if cache is not None and cache.x.shape == x.shape:
+            moved = np.sqrt(((x - cache.x) ** 2).sum(axis=1))
+            move = float(moved.max()) if len(x) else 0.0
+            if 2.0 * move + margin <= cache.pad:
+                return cache, moved
         pad = max(float(margin), self._pad)
-        cand = self._build_candidates(x, pad)
-        self._cache = (x.copy(), pad, cand)
-        return cand
+        near = self._self_pairs(x, x, pad)
+        cand = self._build_candidates(x, pad, own=near)
+        dist = pair_distances(self._extended(x), cand.quads)
+        self._cache = _Reuse(x=x.copy(), pad=pad, cand=cand, near=near, dist=dist)
+        return self._cache, None
+
+    def _self_pairs(
+        self, x0: FloatArray, x1: FloatArray, margin: float
+    ) -> tuple[IntArray, IntArray]:
+        """The broad phase's segment pairs and node–segment pairs on ``x0 -> x1`` within
+        contact + activation + ``margin`` (none without self-contact)."""
+        if not (self.contact.self_contact and len(self.edges) > 1):
+            return _NO_PAIRS, _NO_PAIRS
+        extra = 0.5 * (self.dhat + margin)
+        return near_pairs(
+            x0, x1, self.edges, self._incident, self.radius + extra, self.node_radius + extra,
+            self.excluded,
+        )  # fmt: skip
+
+    def _swept_pairs(self, x: FloatArray, dx: FloatArray) -> tuple[IntArray, IntArray]:
+        """:meth:`_self_pairs` along the step ``x -> x + dx`` without margin: picked out of the
+        reused candidate set by the same box tests when that set covers the step
+        (:meth:`_Reuse.covers`; the same pairs as a fresh broad phase), else a fresh one."""
+        x1 = x + dx
+        cache = self._cache
+        if (
+            cache is not None
+            and self.contact.self_contact
+            and len(self.edges) > 1
+            and cache.covers(x, x1)
+        ):
+            extra = 0.5 * (self.dhat + 0.0)
+            return near_subset(
+                x, x1, self.edges, self.radius + extra, self.node_radius + extra, cache.near
+            )
+        return self._self_pairs(x, x1, 0.0)
 
     def _build_candidates(
-        self, x: FloatArray, margin: float, step: FloatArray | None = None
+        self,
+        x: FloatArray,
+        margin: float,
+        step: FloatArray | None = None,
+        own: tuple[IntArray, IntArray] | None = None,
     ) -> _Candidates:
         """Candidates at ``x`` within ``margin``; with ``step``, along the straight path
         ``x -> x + step`` (swept boxes for the network's own pairs, the step's largest node
-        motion added to ``margin`` for obstacles)."""
+        motion added to ``margin`` for obstacles). ``own``: the network's own pairs as
+        :meth:`_self_pairs` finds them for these arguments (default: found here)."""
         edges = self.edges
         quads: list[IntArray] = []
         dmins: list[FloatArray] = []
@@ -361,29 +434,26 @@ class ContactPotential:
             weights.append(w)
             molls.append(m)
 
-        if self.contact.self_contact and len(edges) > 1:
-            extra = 0.5 * (self.dhat + margin)
-            pairs, ns = near_pairs(
-                x, x if step is None else x + step, edges, self._incident, self.radius + extra,
-                self.node_radius + extra, self.excluded,
-            )  # fmt: skip
-            if len(pairs):
-                k, j = pairs[:, 0], pairs[:, 1]
-                L = self.length
-                add(
-                    np.concatenate([edges[k], edges[j]], axis=1),
-                    self.radius[k] + self.radius[j],
-                    0.5 * (L[k] + L[j]),
-                    MOLLIFIER * (L[k] * L[j]) ** 2,
-                )
-            if len(ns):  # nodes against segments: they carry side-by-side (parallel) contact
-                node, seg = ns[:, 0], ns[:, 1]
-                add(
-                    np.stack([node, node, edges[seg, 0], edges[seg, 1]], axis=1),
-                    self.node_radius[node] + self.radius[seg],
-                    self.node_length[node],
-                    np.zeros(len(node)),
-                )
+        if own is None:
+            own = self._self_pairs(x, x if step is None else x + step, margin)
+        pairs, ns = own
+        if len(pairs):
+            k, j = pairs[:, 0], pairs[:, 1]
+            L = self.length
+            add(
+                np.concatenate([edges[k], edges[j]], axis=1),
+                self.radius[k] + self.radius[j],
+                0.5 * (L[k] + L[j]),
+                MOLLIFIER * (L[k] * L[j]) ** 2,
+            )
+        if len(ns):  # nodes against segments: they carry side-by-side (parallel) contact
+            node, seg = ns[:, 0], ns[:, 1]
+            add(
+                np.stack([node, node, edges[seg, 0], edges[seg, 1]], axis=1),
+                self.node_radius[node] + self.radius[seg],
+                self.node_length[node],
+                np.zeros(len(node)),
+            )
         if step is not None and len(step):
             margin += float(np.sqrt((step**2).sum(axis=1).max()))
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
@@ -449,25 +519,33 @@ class ContactPotential:
     ) -> tuple[float, FloatArray | None, HessianBlocks | None]:
         """:meth:`evaluate` with the Hessian as its local blocks (:class:`HessianBlocks`)."""
         x = np.ascontiguousarray(x, dtype=float)
-        cand = self.candidates(x)
+        reuse, moved = self._reused(x)
+        cand = reuse.cand
         xe = self._extended(x)
         grad = np.zeros_like(xe)
-        P = len(cand.quads)
-        dist = np.empty(P)
+        # the pairs that may be within reach: their distance where the candidates were found
+        # less their nodes' motions since (the others carry no energy)
+        move = np.zeros(len(xe))
+        if moved is not None:
+            move[: self.n_nodes] = moved
+        near = within_reach(cand.quads, reuse.dist, move, cand.dmin + self.dhat)
+        quads, dmin = cand.quads[near], cand.dmin[near]
+        weight, mollify = cand.weight[near], cand.mollify[near]
+        dist = np.empty(len(near))
         energy = pair_barrier(
-            xe, cand.quads, cand.dmin, cand.weight, cand.mollify, self.dhat, self.kappa,
-            need_grad, 0, grad, np.empty((0, 12, 12)), dist,
+            xe, quads, dmin, weight, mollify, self.dhat, self.kappa, need_grad, 0, grad,
+            np.empty((0, 12, 12)), dist,
         )  # fmt: skip
         if not np.isfinite(energy):
             return np.inf, None, None
         # Hessian blocks of the active pairs only (the candidate set is padded)
-        active = np.flatnonzero(dist < cand.dmin + self.dhat)
-        quads = np.ascontiguousarray(cand.quads[active])
+        active = np.flatnonzero(dist < dmin + self.dhat)
+        quads = np.ascontiguousarray(quads[active])
         hloc = np.zeros((len(active) if need_hess else 0, 12, 12))
         if need_hess and len(active):
             pair_barrier(
-                xe, quads, cand.dmin[active], cand.weight[active], cand.mollify[active],
-                self.dhat, self.kappa, False, int(need_hess), grad, hloc, np.empty(len(active)),
+                xe, quads, dmin[active], weight[active], mollify[active], self.dhat, self.kappa,
+                False, int(need_hess), grad, hloc, np.empty(len(active)),
             )  # fmt: skip
         blocks = []
         for f, (nodes, dmin, weight) in zip(self._floors, cand.floors, strict=True):
@@ -510,7 +588,7 @@ class ContactPotential:
         disp = float(np.sqrt((dx**2).sum(axis=1)).max()) if len(dx) else 0.0
         if disp == 0.0:
             return 1.0
-        cand = self._build_candidates(x, 0.0, step=dx)
+        cand = self._build_candidates(x, 0.0, step=dx, own=self._swept_pairs(x, dx))
         self._swept = (x.copy(), x + dx, cand)
         return self._bound_on(x, dx, cand, close_fraction)
 
