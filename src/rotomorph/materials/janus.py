@@ -120,14 +120,21 @@ class FilamentSection:
             np.atleast_1d(np.asarray(a, dtype=float))[:, None]
             for a in (omega_star, eps_parallel, eps_perpendicular, eps_passive)
         )
+        eps_zz, denom = self._axial_eigenstrain(w, ep, et, eq)
+        xy, act = self.axial.points, self.axial.active
+        factor = np.where(act, 2.0 * (ep - et) * w / (self.radius * denom), 0.0)  # Δ sin2φ / r
+        rot = np.column_stack([-xy[:, 1], xy[:, 0]])  # r e_θ
+        return eps_zz, factor[..., None] * rot
+
+    def _axial_eigenstrain(
+        self, w: FloatArray, ep: FloatArray, et: FloatArray, eq: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """ε*_zz ``(n, Q)`` and 1 + tan²φ ``(n, Q)`` of columns ``(n, 1)`` (see
+        :meth:`eigenfields`)."""
         xy, act = self.axial.points, self.axial.active
         u2 = np.sum(xy * xy, axis=1) / self.radius**2
         denom = 1.0 + w * w * u2  # 1 + tan²φ
-        delta = ep - et
-        eps_zz = np.where(act, et + delta / denom, eq)
-        factor = np.where(act, 2.0 * delta * w / (self.radius * denom), 0.0)  # Δ sin2φ / r
-        rot = np.column_stack([-xy[:, 1], xy[:, 0]])  # r e_θ
-        return eps_zz, factor[..., None] * rot
+        return np.where(act, et + (ep - et) / denom, eq), denom
 
     def natural_strains(
         self,
@@ -180,9 +187,9 @@ class FilamentSection:
     def _solve_curved(self, states: FloatArray) -> FloatArray:
         """``(m, 3)`` rows (ε_c, κ1, κ2) of distinct curved print states ``(m, 6)``."""
         w, ep, et, eq = (states[:, i : i + 1] for i in range(4))
-        eps_zz, _ = self.eigenfields(*states[:, :4].T)
-        xy, act = self.axial.points, self.axial.active
-        sin2 = 1.0 - 1.0 / (1.0 + w * w * np.sum(xy * xy, axis=1) / self.radius**2)
+        eps_zz, denom = self._axial_eigenstrain(w, ep, et, eq)
+        act = self.axial.active
+        sin2 = 1.0 - 1.0 / denom
         eps_t = np.where(act, et + 0.5 * (ep - et) * sin2, eq)  # mean in-plane eigenstrain
         ew = self.axial.modulus * self.axial.weights
         transverse = eps_t @ ew / self.axial.axial_stiffness

@@ -173,14 +173,15 @@ class AxialSection:
             )
         ew = self.modulus * self.weights
         w = ew / factor
-        wx = w[..., None] * x  # (n, Q, 2)
+        # the quadrature sums as matrix products (n, Q) @ (Q, k)
+        xx = (x[:, :, None] * x[:, None, :]).reshape(-1, 4)
         m = np.empty((*eps.shape[:-1], 3, 3))
         m[..., 0, 0] = w.sum(axis=-1)
-        m[..., 0, 1:] = m[..., 1:, 0] = -wx.sum(axis=-2)
-        m[..., 1:, 1:] = np.einsum("nqk,ql->nkl", wx, x)
+        m[..., 0, 1:] = m[..., 1:, 0] = -(w @ x)
+        m[..., 1:, 1:] = (w @ xx).reshape(-1, 2, 2)
         rhs = np.empty((*eps.shape[:-1], 3))
-        rhs[..., 0] = np.einsum("nq,q->n", eps, ew)
-        rhs[..., 1:] = -np.einsum("nq,qk->nk", eps, ew[:, None] * x)
+        rhs[..., 0] = eps @ ew
+        rhs[..., 1:] = -(eps @ (ew[:, None] * x))
         sol = np.linalg.solve(m, rhs[..., None])[..., 0]
         eps_g, g = sol[..., 0], sol[..., 1:]
         eps_c = (eps_g - g @ self.centroid) / (1.0 - k0 @ self.centroid)
