@@ -2,13 +2,13 @@
 
 Networks (lattices) give Hessians that are sparse but not banded. Their sparsity pattern is
 fixed by the topology, so the fill-reducing ordering, the elimination tree and the pattern of
-the factor are computed once (:func:`analyse`) and every later factorization is purely numeric
-(:func:`factor`). The numeric phase is the up-looking algorithm of CSparse (Davis, *Direct
-Methods for Sparse Linear Systems*, SIAM 2006, §4.7: ``cs_etree``, ``cs_ereach``, ``cs_chol``);
-a non-positive pivot reports that the (shifted) matrix is not positive definite, which is what
-modified Newton needs. The ordering is the minimum-degree ordering SuperLU computes for
-``A + A^T`` (SciPy's ``splu`` with ``MMD_AT_PLUS_A``), taken once from a factorization of the
-pattern.
+the factor are computed once (:func:`analyse`: ``cs_etree`` and the row patterns of
+``cs_ereach`` in Davis, *Direct Methods for Sparse Linear Systems*, SIAM 2006, §4) and every
+later factorization is purely numeric (:func:`factor`): a supernodal left-looking Cholesky on
+dense panels (:mod:`rotomorph.solve.supernodal`). A non-positive pivot reports that the
+(shifted) matrix is not positive definite, which is what modified Newton needs. The ordering is
+the minimum-degree ordering SuperLU computes for ``A + A^T`` (SciPy's ``splu`` with
+``MMD_AT_PLUS_A``), taken once from a factorization of the pattern.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from rotomorph._typing import FloatArray, IntArray
+from rotomorph.solve.supernodal import _ereach, factor_numeric, solve_numeric, supernodes
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,13 +39,13 @@ class Symbolic:
     lp: IntArray  # column pointers of L
 
     @cached_property
-    def row_pattern(self) -> tuple[IntArray, IntArray, IntArray, IntArray]:
-        """``li, rp, rows, slot``: the row indices of L (fixed by the pattern, shared by every
-        numeric factor) and row k of L off the diagonal, ``rows[rp[k]:rp[k + 1]]``, in the
-        topological order of the elimination tree with the position (``slot``) of each entry
-        in L's arrays; found at the first factorization (a pattern analysed only to measure
-        its fill is never factored)."""
-        return _row_patterns(self.n, self.bp, self.bi, self.parent, self.lp)  # type: ignore[no-any-return]
+    def supernodal(
+        self,
+    ) -> tuple[IntArray, IntArray, IntArray, IntArray, IntArray, IntArray, IntArray]:
+        """The supernodal structure of the factor (:func:`rotomorph.solve.supernodal.supernodes`:
+        ``first, rp, ri, px, snode, dst, diag``), found at the first factorization (a pattern
+        analysed only to measure its fill is never factored)."""
+        return supernodes(self.n, self.bp, self.bi, self.parent, self.lp)  # type: ignore[no-any-return]
 
 
 @njit(cache=True)
@@ -64,29 +65,6 @@ def _etree(n, bp, bi):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _ereach(k, bp, bi, parent, s, w):  # pragma: no cover - compiled
-    """Pattern of row k of L (columns < k) in s[top:], topologically ordered."""
-    n = s.shape[0]
-    top = n
-    w[k] = k
-    for p in range(bp[k], bp[k + 1]):
-        i = bi[p]
-        if i > k:
-            continue
-        length = 0
-        while w[i] != k:
-            s[length] = i
-            length += 1
-            w[i] = k
-            i = parent[i]
-        while length > 0:
-            top -= 1
-            length -= 1
-            s[top] = s[length]
-    return top
-
-
-@njit(cache=True)
 def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
     counts = np.ones(n, dtype=np.int64)
     s = np.empty(n, dtype=np.int64)
@@ -96,88 +74,6 @@ def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
         for t in range(top, n):
             counts[s[t]] += 1
     return counts
-
-
-@njit(cache=True)
-def _row_patterns(n, bp, bi, parent, lp):  # pragma: no cover - compiled
-    """Row indices ``li`` of L and the pattern of every row of L in the order the up-looking
-    factorization visits it (``cs_ereach``): ``rows[rp[k]:rp[k + 1]]`` with the ``slot`` of
-    each entry in L's arrays. Both depend on the pattern only, so every numeric factorization
-    of it reuses them instead of walking the elimination tree again."""
-    nnz = lp[n]
-    li = np.empty(nnz, dtype=np.int64)
-    rp = np.empty(n + 1, dtype=np.int64)
-    rows = np.empty(nnz - n, dtype=np.int64)
-    slot = np.empty(nnz - n, dtype=np.int64)
-    c = lp[:-1].copy()
-    s = np.empty(n, dtype=np.int64)
-    w = -np.ones(n, dtype=np.int64)
-    m = 0
-    for k in range(n):
-        rp[k] = m
-        top = _ereach(k, bp, bi, parent, s, w)
-        for t in range(top, n):
-            i = s[t]
-            rows[m] = i
-            slot[m] = c[i]
-            li[c[i]] = k
-            c[i] += 1
-            m += 1
-        li[c[k]] = k
-        c[k] += 1
-    rp[n] = m
-    return li, rp, rows, slot
-
-
-@njit(cache=True)
-def _numeric(n, bp, bi, bx, shift, lp, li, rp, rows, slot, lx):  # pragma: no cover - compiled
-    """Up-looking Cholesky of B + diag(shift) into ``lx``; False at a non-positive pivot.
-
-    Row k: ``L[k, :k]`` solves ``L[:k, :k] y = B[:k, k]`` over the row's pattern (in
-    elimination-tree order), then ``L[k, k] = sqrt(B[k, k] - y.y)``. The operations and their
-    order are those of CSparse's ``cs_chol``, with the pattern precomputed.
-    """
-    x = np.zeros(n)
-    for k in range(n):
-        for p in range(bp[k], bp[k + 1]):
-            i = bi[p]
-            if i <= k:
-                x[i] = bx[p]
-        d = x[k] + shift[k]
-        x[k] = 0.0
-        for t in range(rp[k], rp[k + 1]):
-            i = rows[t]
-            lki = x[i] / lx[lp[i]]
-            x[i] = 0.0
-            end = slot[t]
-            for p in range(lp[i] + 1, end):
-                x[li[p]] -= lx[p] * lki
-            d -= lki * lki
-            lx[end] = lki
-        if not d > 0.0:
-            return False
-        lx[lp[k]] = np.sqrt(d)
-    return True
-
-
-@njit(cache=True)
-def _solve(n, lp, li, lx, perm, b):  # pragma: no cover - compiled
-    y = np.empty(n)
-    for i in range(n):
-        y[i] = b[perm[i]]
-    for j in range(n):
-        y[j] /= lx[lp[j]]
-        for p in range(lp[j] + 1, lp[j + 1]):
-            y[li[p]] -= lx[p] * y[j]
-    for j in range(n - 1, -1, -1):
-        v = y[j]
-        for p in range(lp[j] + 1, lp[j + 1]):
-            v -= lx[p] * y[li[p]]
-        y[j] = v / lx[lp[j]]
-    out = np.empty(n)
-    for i in range(n):
-        out[perm[i]] = y[i]
-    return out
 
 
 def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
@@ -235,8 +131,21 @@ class SparseCholesky:
 
     def solve(self, b: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
-        s = self._sym
-        return _solve(s.n, s.lp, s.row_pattern[0], self._lx, s.perm, np.ascontiguousarray(b, float))
+        first, rp, ri, px = self._sym.supernodal[:4]
+        b = np.ascontiguousarray(b, dtype=float)
+        return solve_numeric(first, rp, ri, px, self._lx, self._sym.perm, b)  # type: ignore[no-any-return]
+
+    def lower(self) -> FloatArray:
+        """The factor ``L`` of the permuted matrix ``A[perm][:, perm]`` as a dense array (for
+        tests)."""
+        first, rp, ri, px = self._sym.supernodal[:4]
+        out = np.zeros((self._sym.n, self._sym.n))
+        for s in range(len(first) - 1):
+            rows = ri[rp[s] : rp[s + 1]]
+            width = int(first[s + 1] - first[s])
+            panel = self._lx[px[s] : px[s + 1]].reshape(width, len(rows)).T
+            out[rows, first[s] : first[s + 1]] = panel
+        return np.tril(out)
 
 
 def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky | None:
@@ -244,8 +153,8 @@ def factor(sym: Symbolic, data: FloatArray, shift: FloatArray) -> SparseCholesky
 
     Returns ``None`` when it is not positive definite.
     """
-    lx = np.empty(int(sym.lp[-1]))
-    bx = np.ascontiguousarray(data[sym.src])
+    structure = sym.supernodal
+    lx = np.empty(int(structure[3][-1]))
     sh = np.ascontiguousarray(np.broadcast_to(shift, (sym.n,)), dtype=float)[sym.perm]
-    ok = _numeric(sym.n, sym.bp, sym.bi, bx, sh, sym.lp, *sym.row_pattern, lx)
+    ok = factor_numeric(np.ascontiguousarray(data, dtype=float), sym.src, sh, *structure, lx)
     return SparseCholesky(sym, lx) if ok else None
