@@ -17,9 +17,12 @@ Two certificates, cheapest first:
    of the pencil ``H v = lambda M v`` restricted to the ``M``-orthogonal complement of the
    rigid span (``M`` the solver's diagonal metric: Voronoi length per position DOF, ``l^3`` per
    twist angle, so ``lambda`` has units of N/mm²). Small problems use a dense symmetric
-   eigensolver; large ones ARPACK's Lanczos in shift-invert mode (SciPy ``eigsh``) with the
-   shift below the lowest eigenvalue, found by trial factorizations (Ericsson & Ruhe,
-   *Math. Comp.* 35, 1980), and the rigid span projected out of every solve.
+   eigensolver; large ones shift-invert Lanczos (:mod:`rotomorph.solve.lanczos`, stopping as
+   soon as the wanted Ritz values converge; ARPACK's implicitly restarted Lanczos, SciPy
+   ``eigsh``, if they have not within its basis) with the shift below the lowest eigenvalue,
+   found by trial factorizations (Ericsson & Ruhe, *Math. Comp.* 35, 1980; a trial that a
+   rigid direction's negative Rayleigh quotient already rules out is skipped), and the rigid
+   span projected out of every solve.
 
 ``stable`` is True when the Cholesky certificate succeeds or the lowest eigenvalue is above
 ``-tol * scale`` (``scale`` the largest diagonal ratio ``H_ii / M_ii``): an eigenvalue within
@@ -38,6 +41,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rotomorph._typing import FloatArray, IntArray
+from rotomorph.solve.lanczos import shift_invert_lanczos
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix, factorize, matvec
 
 __all__ = ["DENSE_LIMIT", "Spectrum", "analyse_hessian", "to_csc"]
@@ -116,22 +120,26 @@ def _dense(H: Any) -> FloatArray:
     return np.array(H, dtype=float)
 
 
-def _rigid_null_space(H: Any, M: FloatArray, rigid: FloatArray, tol: float) -> FloatArray:
-    """``M``-orthonormal basis of the combinations of ``rigid`` that ``H`` annihilates."""
+def _rigid_null_space(
+    H: Any, M: FloatArray, rigid: FloatArray, tol: float
+) -> tuple[FloatArray, float]:
+    """``M``-orthonormal basis of the combinations of ``rigid`` that ``H`` annihilates, and the
+    lowest Rayleigh quotient ``v^T H v / v^T M v`` over the span of ``rigid`` (an upper bound
+    of the lowest eigenvalue of the pencil; ``inf`` without rigid directions)."""
     if rigid.size == 0:
-        return np.zeros((len(M), 0))
+        return np.zeros((len(M), 0)), np.inf
     # M-orthonormalise through the small Gram matrix (k <= 6 columns)
     G = np.einsum("ik,i,il->kl", rigid, M, rigid)
     w, V = np.linalg.eigh(G)
     ok = w > 1e-12 * max(float(w.max()), 1e-300)
     basis = rigid @ (V[:, ok] / np.sqrt(w[ok]))
     if basis.shape[1] == 0:
-        return basis
+        return basis, np.inf
     cols = range(basis.shape[1])
     HB = np.column_stack([matvec(H, np.ascontiguousarray(basis[:, j])) for j in cols])
     C = basis.T @ HB
     mu, W = np.linalg.eigh(0.5 * (C + C.T))
-    return basis @ W[:, np.abs(mu) <= tol]
+    return basis @ W[:, np.abs(mu) <= tol], float(mu[0])
 
 
 def _pivots(R: FloatArray) -> IntArray:
@@ -197,7 +205,9 @@ def analyse_hessian(
     n = len(M)
     d = np.asarray(H.diagonal if isinstance(H, BandedMatrix) else H.diagonal(), dtype=float)
     scale = max(float(np.max(np.abs(d) / M)) if n else 1.0, 1e-300)
-    R = _rigid_null_space(H, M, np.zeros((n, 0)) if rigid is None else rigid, null_tol * scale)
+    R, bound = _rigid_null_space(
+        H, M, np.zeros((n, 0)) if rigid is None else rigid, null_tol * scale
+    )
     k = R.shape[1]
     m = n - k
     if m <= 0:
@@ -213,7 +223,7 @@ def analyse_hessian(
     if m <= DENSE_LIMIT:
         lam, vec = _dense_eigen(H, M, R, want)
     else:
-        lam, vec, extra = _sparse_eigen(H, M, R, want, scale, modes, tol)
+        lam, vec, extra = _sparse_eigen(H, M, R, want, scale, modes, tol, bound)
         nfact += extra
     stable = bool(lam[0] >= -tol * scale)
     return Spectrum(
@@ -250,14 +260,28 @@ def _dense_eigen(H: Any, M: FloatArray, R: FloatArray, want: int) -> tuple[Float
 
 
 def _sparse_eigen(
-    H: Any, M: FloatArray, R: FloatArray, want: int, scale: float, vectors: bool, tol: float
+    H: Any,
+    M: FloatArray,
+    R: FloatArray,
+    want: int,
+    scale: float,
+    vectors: bool,
+    tol: float,
+    bound: float = np.inf,
 ) -> tuple[FloatArray, FloatArray | None, int]:
-    """Shift-invert Lanczos with the shift below the lowest eigenvalue."""
+    """Shift-invert Lanczos with the shift below the lowest eigenvalue.
+
+    The shift is the first of ``-1e-14 scale, -1e-13 scale, ...`` at which ``H - sigma M``
+    factors; those not below ``bound`` (a Rayleigh quotient, so at least the lowest eigenvalue)
+    cannot, and are skipped without a factorization.
+    """
     n = len(M)
     extra = 0
     fac: Any = None
     sigma = 0.0
     delta = 1e-14 * scale
+    while delta <= -bound:
+        delta *= 10.0
     while fac is None:
         extra += 1
         fac = factorize(H, delta * M)
@@ -276,9 +300,19 @@ def _sparse_eigen(
             b = b - RM.T @ (R.T @ b)  # the transposed projector removes rigid loads first
         return project(fac.solve(b))
 
+    v0 = project(np.cos(np.arange(n) * 2.399963229728653) + 0.5)
+    found = shift_invert_lanczos(op_inv, M, v0, want)
+    if found is not None:
+        theta, vec = found
+        lam = sigma + 1.0 / theta[::-1]  # the largest theta is the lowest eigenvalue
+        if not vectors and lam[0] >= -tol * scale:
+            return lam, None, extra
+        vec = vec[:, ::-1]
+        norms = np.sqrt(np.einsum("ij,i,ij->j", vec, M, vec))
+        return lam, vec / norms, extra
+    # not converged within the Lanczos basis: ARPACK's implicitly restarted Lanczos
     lin = spla.LinearOperator((n, n), matvec=lambda v: matvec(H, np.ravel(v)), dtype=float)
     opinv = spla.LinearOperator((n, n), matvec=op_inv, dtype=float)
-    v0 = project(np.cos(np.arange(n) * 2.399963229728653) + 0.5)
     kwargs = dict(k=want, M=sp.diags(M), sigma=sigma, which="LM", OPinv=opinv, v0=v0, tol=1e-8)
     if not vectors:
         # Ritz vectors cost more than the eigenvalues (dseupd); get them only when needed
