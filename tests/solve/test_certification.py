@@ -105,7 +105,31 @@ def test_free_free_beam_bending_eigenvalues():
 
 def test_stability_rejects_a_bad_count():
     with pytest.raises(InvalidParameterError, match="count"):
-        stability(column(5), count=0)
+        stability(column(5), count=-1)
+    with pytest.raises(InvalidParameterError, match="count"):
+        stability(column(5), count=1.5)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("factor", [0.8, 1.2])
+def test_stability_verdict_only_computes_the_mode_when_unstable(factor):
+    # count=0: one Cholesky factorization decides a stable state (no eigenvalue, no mode); an
+    # unstable one gets its lowest eigenvalue and mode, the same as count=1 gives
+    n = 41
+    model, supports = column(n), Supports.clamp_ends(n)
+    loads = Loads(forces=[(n - 1, (-factor * P_CR, 0.0, 0.0))])
+    straight = solve_static(model, supports, loads, options=NewtonOptions(check_stability=False))
+    quick = stability(model, straight.state, supports, loads, count=0)
+    full = stability(model, straight.state, supports, loads, count=1)
+    assert quick.stable == full.stable == (factor < 1)
+    if factor < 1:
+        assert quick.certificate == "cholesky" and len(quick.eigenvalues) == 0
+        assert quick.modes.count == 0
+    else:
+        assert quick.eigenvalues[0] == pytest.approx(full.eigenvalues[0], rel=1e-8)
+        assert quick.eigenvalues[0] < 0 and quick.modes.count == 1
+        np.testing.assert_allclose(
+            np.abs(quick.modes.displacements[0]), np.abs(full.modes.displacements[0]), atol=1e-8
+        )
 
 
 def test_stability_docstring_example_runs():

@@ -61,7 +61,7 @@ from rotomorph.rod.state import State
 from rotomorph.solve.continuation import ContinuationResult, continuation
 from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
-from rotomorph.solve.stability import stability
+from rotomorph.solve.stability import StabilityResult, stability
 from rotomorph.solve.static import StaticResult, solve_static
 
 __all__ = [
@@ -775,9 +775,8 @@ def _lift_probe(
     diameter = 2.0 * lattice.radius
     if _rise(floor, lattice, resting.positions) > diameter:
         return None, None, 0
-    modes = stability(model, resting.state, supports, Loads(), count=1)
-    phase_log.debug("lift probe: lowest unsupported eigenvalue %.3g", modes.eigenvalues[0])
-    if modes.eigenvalues[0] >= 0:
+    modes = _unsupported_instability(model, resting.state, supports)
+    if modes is None:
         return None, None, 0
     v = modes.modes.displacements[0][:, 2]
     if float(np.ptp(v)) == 0.0:
@@ -875,8 +874,7 @@ def _refine_lift_off(
 
     def buckled(p: float, start: State) -> tuple[bool, State]:
         model, res = resting(p, start)
-        eig = stability(model, res.state, supports, Loads(), count=1).eigenvalues[0]
-        return bool(eig < 0), res.state
+        return _unsupported_instability(model, res.state, supports) is not None, res.state
 
     def bisect(test, lo: float, lo_state: State, hi: float) -> tuple[float, float]:  # type: ignore[no-untyped-def]
         while hi - lo > tol:
@@ -896,12 +894,23 @@ def _refine_lift_off(
     # the weightless lattice is unstable where the lift-off was found; step back to a stable one
     j = k
     while j > 0:
-        eig = stability(natural(float(values[j])), states[j], supports, Loads(), count=1)
-        if eig.eigenvalues[0] >= 0:
+        if _unsupported_instability(natural(float(values[j])), states[j], supports) is None:
             break
         j -= 1
     buckle = bisect(buckled, float(values[j]), states[j], float(values[j + 1]))
     return lift, buckle
+
+
+def _unsupported_instability(
+    model: Model, state: State, supports: Supports
+) -> StabilityResult | None:
+    """The weightless lattice's lowest mode at ``state`` (a :class:`StabilityResult`) when
+    its lowest eigenvalue is negative, else None. A successful unshifted Cholesky
+    factorization of the reduced Hessian decides the stable case without an eigensolve."""
+    res = stability(model, state, supports, Loads(), count=0)
+    if len(res.eigenvalues):
+        phase_log.debug("lift probe: lowest unsupported eigenvalue %.3g", res.eigenvalues[0])
+    return res if len(res.eigenvalues) and res.eigenvalues[0] < 0 else None
 
 
 def _rise(floor: Floor, lattice: Lattice, positions: FloatArray) -> float:

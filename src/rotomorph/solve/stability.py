@@ -87,10 +87,12 @@ class StabilityResult:
 def mode_fields(objective: RodObjective, vectors: FloatArray) -> Modes:
     """Free-DOF vectors ``(n_free, k)`` of ``objective`` as node and edge fields."""
     lay = objective.model.layout
-    vectors = np.asarray(vectors, dtype=float).reshape(len(objective.free), -1)
-    full = np.zeros((lay.count, vectors.shape[1]))
+    vectors = np.asarray(vectors, dtype=float)
+    k = vectors.size // max(len(objective.free), 1)
+    vectors = vectors.reshape(len(objective.free), k)
+    full = np.zeros((lay.count, k))
     full[objective.free] = vectors
-    disp = full[(lay.pos[:, None] + np.arange(3)).ravel()].T.reshape(vectors.shape[1], -1, 3)
+    disp = full[(lay.pos[:, None] + np.arange(3)).ravel()].T.reshape(k, len(lay.pos), 3)
     return Modes(displacements=disp, twist=full[lay.theta].T.copy())
 
 
@@ -115,7 +117,10 @@ def stability(
     supports, loads
         As for :func:`~rotomorph.solve.static.solve_static` (the same ones as the solve).
     count
-        Number of lowest eigenvalues and modes (>= 1; fewer when the problem is smaller).
+        Number of lowest eigenvalues and modes (fewer when the problem is smaller). 0: the
+        verdict only, from one unshifted Cholesky factorization of the reduced Hessian; the
+        lowest eigenvalue and its mode are computed only when that factorization fails (to
+        decide), otherwise ``eigenvalues`` and ``modes`` are empty.
     tol
         Eigenvalues above ``-tol`` times the largest diagonal ratio ``H_ii / M_ii`` count as
         neutral (stable).
@@ -148,19 +153,19 @@ def stability(
     0.8 True True
     1.2 False False
     """
-    if int(count) != count or count < 1:
-        raise InvalidParameterError("count", f"must be an integer >= 1; got {count}")
+    if int(count) != count or count < 0:
+        raise InvalidParameterError("count", f"must be an integer >= 0; got {count}")
     state = model.reference_state() if state is None else state
     obj = RodObjective(model, state, supports or Supports(), loads or Loads())
     _, g, H = obj.evaluate(obj.vector(), True, 1)
     spec = analyse_hessian(
         H, obj.metric(), obj.rigid_modes(), count=int(count), modes=True, tol=tol
     )
-    assert spec.modes is not None  # asked for
+    vectors = np.zeros((len(obj.free), 0)) if spec.modes is None else spec.modes
     return StabilityResult(
         stable=spec.stable,
         eigenvalues=spec.eigenvalues,
-        modes=mode_fields(obj, spec.modes),
+        modes=mode_fields(obj, vectors),
         rigid_modes=spec.rigid,
         certificate=spec.certificate,
         gradient_norm=float(np.linalg.norm(g)),
