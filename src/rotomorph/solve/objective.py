@@ -235,6 +235,7 @@ class RodObjective:
         self._metric = m[self.free]
         self._node_metric = m[lay.pos]
         self._theta_metric = m[lay.theta]
+        self._layout_metric: FloatArray | None = None  # the metric on every layout DOF
         self._free_body = not self._fixed_mask.any()
         wt = np.ones(lay.count)
         wt[lay.theta] = 1.0 / lmean
@@ -469,11 +470,14 @@ class RodObjective:
             lay.theta,
             lay.count,
         )
-        m = np.zeros(lay.count)
-        m[self._pos_index] = np.repeat(self._node_metric, 3)
-        m[self._theta_index] = self._theta_metric
-        G = (U * m) @ U.T
-        c = np.linalg.solve(G, (U * m) @ du)
+        if self._layout_metric is None:
+            m = np.zeros(lay.count)
+            m[self._pos_index] = np.repeat(self._node_metric, 3)
+            m[self._theta_index] = self._theta_metric
+            self._layout_metric = m
+        Um = U * self._layout_metric
+        G = Um @ U.T
+        c = np.linalg.solve(G, Um @ du)
         return (du - c @ U)[self.free]
 
     def shift_floor(self, g: FloatArray) -> float:
