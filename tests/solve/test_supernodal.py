@@ -83,3 +83,18 @@ def test_supernodal_factor_reports_the_first_non_positive_pivot(rng):
         j = int(sym.perm[where])
         shift[j] = -A[j, j] - 1.0
         assert factor(sym, A.data, shift) is None
+
+
+def test_analysis_lists_the_permuted_upper_triangle_by_column_then_row(rng):
+    A = _random_spd_on(_lattice_pattern(3, 6, rng), rng)
+    perm = rng.permutation(A.shape[0]).astype(np.int64)
+    sym = analyse(A, perm)
+    inv = np.argsort(perm)
+    col = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    bi, bj = inv[A.indices], inv[col]
+    upper = np.flatnonzero(bi <= bj)
+    order = upper[np.lexsort((bi[upper], bj[upper]))]
+    np.testing.assert_array_equal(sym.src, order)
+    np.testing.assert_array_equal(sym.bi, bi[order])
+    np.testing.assert_array_equal(np.diff(sym.bp), np.bincount(bj[order], minlength=A.shape[0]))
+    np.testing.assert_array_equal(A.data[sym.src[sym.bp[1:] - 1]], A.diagonal()[perm])

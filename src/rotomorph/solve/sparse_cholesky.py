@@ -76,6 +76,48 @@ def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
     return counts
 
 
+@njit(cache=True)
+def _permuted_upper(n, indptr, indices, inv):  # pragma: no cover - compiled
+    """Upper triangle of ``B = A[perm][:, perm]`` in CSC (rows ascending; repeated entries in
+    their order in ``A``) and the position ``src`` of each entry in ``A``'s data: a stable
+    counting sort by row, then by column."""
+    row_count = np.zeros(n + 1, dtype=np.int64)
+    for col in range(n):
+        j = inv[col]
+        for p in range(indptr[col], indptr[col + 1]):
+            i = inv[indices[p]]
+            if i <= j:
+                row_count[i + 1] += 1
+    for i in range(n):
+        row_count[i + 1] += row_count[i]
+    m = row_count[n]
+    by_row = np.empty(m, dtype=np.int64)
+    col_of = np.empty(m, dtype=np.int64)
+    slot = row_count[:-1].copy()
+    col_count = np.zeros(n + 1, dtype=np.int64)
+    for col in range(n):
+        j = inv[col]
+        for p in range(indptr[col], indptr[col + 1]):
+            i = inv[indices[p]]
+            if i <= j:
+                by_row[slot[i]] = p
+                col_of[slot[i]] = j
+                slot[i] += 1
+                col_count[j + 1] += 1
+    for j in range(n):
+        col_count[j + 1] += col_count[j]
+    bp = col_count.copy()
+    bi = np.empty(m, dtype=np.int64)
+    src = np.empty(m, dtype=np.int64)
+    for q in range(m):
+        j = col_of[q]
+        p = by_row[q]
+        bi[col_count[j]] = inv[indices[p]]
+        src[col_count[j]] = p
+        col_count[j] += 1
+    return bp, bi, src
+
+
 def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     """Ordering, elimination tree and factor pattern of the symmetric pattern of ``A``.
 
@@ -89,19 +131,8 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
         perm = ordering(A)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
-    # upper triangle of B = A[perm][:, perm], with a map back into A.data
-    coo_row = A.indices.astype(np.int64)
-    coo_col = np.repeat(np.arange(n), np.diff(A.indptr))
-    bi_all, bj_all = inv[coo_row], inv[coo_col]
-    upper = bi_all <= bj_all
-    # by column, then row: one sort of the combined key (np.lexsort's order; a canonical matrix
-    # has no repeated entry, so the keys are distinct and any sort gives that order)
-    key = bj_all[upper] * n + bi_all[upper]
-    order = np.argsort(key) if A.has_canonical_format else np.argsort(key, kind="stable")
-    src = np.flatnonzero(upper)[order].astype(np.int64)
-    bi = bi_all[upper][order].astype(np.int64)
-    bj = bj_all[upper][order]
-    bp = np.concatenate([[0], np.cumsum(np.bincount(bj, minlength=n))]).astype(np.int64)
+    bp, bi, src = _permuted_upper(n, A.indptr.astype(np.int64), A.indices.astype(np.int64), inv)
+    bj = np.repeat(np.arange(n), np.diff(bp))
     diag_src = np.full(n, -1, dtype=np.int64)
     is_diag = bi == bj
     diag_src[bj[is_diag]] = src[is_diag]

@@ -90,14 +90,30 @@ def supernodes(n, bp, bi, parent, lp):  # pragma: no cover - compiled
         if first[s] == k:
             ri[fill[s]] = k
             fill[s] += 1
-    # where each upper-triangle entry (row i <= column j) lands: L[j, i]
-    dst = np.empty(bp[n], dtype=np.int64)
+    # where each upper-triangle entry (row i <= column j) lands: L[j, i], found supernode by
+    # supernode with the entries listed by row (a counting sort) and a row -> position map
+    by_row = np.zeros(n + 1, dtype=np.int64)
+    for p in range(bp[n]):
+        by_row[bi[p] + 1] += 1
+    for i in range(n):
+        by_row[i + 1] += by_row[i]
+    entries = np.empty(bp[n], dtype=np.int64)
+    column = np.empty(bp[n], dtype=np.int64)
+    slot = by_row[:-1].copy()
     for j in range(n):
         for p in range(bp[j], bp[j + 1]):
-            i = bi[p]
-            s = snode[i]
-            rows = ri[rp[s] : rp[s + 1]]
-            dst[p] = px[s] + (i - first[s]) * rows.shape[0] + np.searchsorted(rows, j)
+            entries[slot[bi[p]]] = p
+            column[slot[bi[p]]] = j
+            slot[bi[p]] += 1
+    dst = np.empty(bp[n], dtype=np.int64)
+    position = np.empty(n, dtype=np.int64)
+    for s in range(ns):
+        nr = rp[s + 1] - rp[s]
+        for t in range(nr):
+            position[ri[rp[s] + t]] = t
+        for i in range(first[s], first[s + 1]):
+            for q in range(by_row[i], by_row[i + 1]):
+                dst[entries[q]] = px[s] + (i - first[s]) * nr + position[column[q]]
     diag = np.empty(n, dtype=np.int64)
     for j in range(n):
         s = snode[j]
