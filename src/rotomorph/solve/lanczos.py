@@ -31,6 +31,7 @@ def shift_invert_lanczos(
     count: int,
     *,
     tol: float = 1e-10,
+    min_steps: int = 0,
     max_steps: int = 120,
 ) -> tuple[FloatArray, FloatArray] | None:
     """The ``count`` largest eigenvalues ``theta`` of ``S = apply(M x)`` and their vectors.
@@ -47,6 +48,11 @@ def shift_invert_lanczos(
         How many of the largest ``theta`` are wanted.
     tol
         Relative residual at which a Ritz value is accepted.
+    min_steps
+        Smallest basis at which convergence is tested. From one start vector Lanczos meets a
+        repeated eigenvalue once in exact arithmetic and its second copy only through round-off,
+        a few steps later: with ``count > 1`` a basis as large as ARPACK's default
+        (``max(2 count + 1, 20)``) gives the copies that time.
     max_steps
         Largest basis; None is returned when the wanted values have not converged by then (or
         the start vector spans fewer than ``count`` directions).
@@ -76,7 +82,7 @@ def shift_invert_lanczos(
             w -= (basis[: j + 1] @ (M * w)) @ basis[: j + 1]
         beta[j] = np.sqrt(w @ (M * w))
         m = j + 1
-        if m >= count:
+        if m >= max(count, min(min_steps, steps)):
             theta, s = sla.eigh_tridiagonal(alpha[:m], beta[: m - 1])
             top = slice(m - count, m)
             residual = np.abs(beta[j] * s[-1, top])
