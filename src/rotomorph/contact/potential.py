@@ -48,6 +48,11 @@ DEFAULT_ACTIVATION = 0.03
 #: how far (per coordinate, relative to the activation distance) a path's end may leave the
 #: boxes swept by the last step bound for its candidates to be reused (``path_is_free``)
 SWEPT_SLACK = 0.25
+#: a step bound's own broad phase at the step's start is kept for the following steps when the
+#: step moves a node at most this many candidate pads; it is padded by ``STEP_ROOM`` times what
+#: the step itself needs
+STEP_REUSE = 2.0
+STEP_ROOM = 1.5
 
 
 _NO_INT = np.zeros(0, dtype=np.int64)
@@ -161,19 +166,17 @@ class _Candidates:
 
 
 @dataclass(frozen=True, eq=False)
-class _Reuse:
-    """A padded candidate set kept for reuse (a Verlet list), found at ``x`` with margin
-    ``pad``."""
+class _NearSet:
+    """The network's own pairs found by a broad phase at ``x`` with margin ``pad``, kept for
+    reuse (a Verlet list)."""
 
-    x: FloatArray  # (N, 3) positions it was found at
+    x: FloatArray  # (N, 3) positions they were found at
     pad: float  # margin (mm)
-    cand: _Candidates
-    near: tuple[IntArray, IntArray]  # the broad phase's segment and node–segment pairs
-    dist: FloatArray  # centre-line distance of every candidate pair at x (mm)
+    pairs: tuple[IntArray, IntArray]  # segment pairs and node–segment pairs
 
     def covers(self, x0: FloatArray, x1: FloatArray) -> bool:
-        """Whether :attr:`near` holds every pair that a broad phase without margin proposes on
-        the straight step ``x0 -> x1``.
+        """Whether :attr:`pairs` holds every pair that a broad phase without margin proposes
+        on the straight step ``x0 -> x1``.
 
         Every coordinate of ``x0`` and ``x1`` lies within ``δ_k`` (per axis ``k``) of its
         node's coordinate in :attr:`x`, so each box over the step lies within the box at
@@ -186,6 +189,15 @@ class _Reuse:
             return False
         delta = np.maximum(np.abs(x0 - self.x), np.abs(x1 - self.x)).max(axis=0)
         return bool(2.0 * float(np.sqrt(delta @ delta)) <= (1.0 - 1e-6) * self.pad)
+
+
+@dataclass(frozen=True, eq=False)
+class _Reuse:
+    """The padded candidate set of :meth:`ContactPotential.candidates`, kept for reuse."""
+
+    near: _NearSet
+    cand: _Candidates
+    dist: FloatArray  # centre-line distance of every candidate pair where found (mm)
 
 
 @dataclass(frozen=True, eq=False)
@@ -286,6 +298,8 @@ class ContactPotential:
         self._lag: FrictionLag | None = None
         # broad-phase cache: reference positions, padded margin, candidates found there
         self._cache: _Reuse | None = None
+        # own pairs found for an earlier step bound, reused by later ones they cover
+        self._step_near: _NearSet | None = None
         # the last step bound's start, end and candidates (reused by path_is_free)
         self._swept: tuple[FloatArray, FloatArray, _Candidates] | None = None
         self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
@@ -368,16 +382,16 @@ class ContactPotential:
         """The reused candidate set of :meth:`candidates` and each node's motion since it was
         found (mm; None when found here)."""
         cache = self._cache
-        if cache is not None and cache.x.shape == x.shape:
-            moved = np.sqrt(((x - cache.x) ** 2).sum(axis=1))
+        if cache is not None and cache.near.x.shape == x.shape:
+            moved = np.sqrt(((x - cache.near.x) ** 2).sum(axis=1))
             move = float(moved.max()) if len(x) else 0.0
-            if 2.0 * move + margin <= cache.pad:
+            if 2.0 * move + margin <= cache.near.pad:
                 return cache, moved
         pad = max(float(margin), self._pad)
-        near = self._self_pairs(x, x, pad)
-        cand = self._build_candidates(x, pad, own=near)
+        near = _NearSet(x.copy(), pad, self._self_pairs(x, x, pad))
+        cand = self._build_candidates(x, pad, own=near.pairs)
         dist = pair_distances(self._extended(x), cand.quads)
-        self._cache = _Reuse(x=x.copy(), pad=pad, cand=cand, near=near, dist=dist)
+        self._cache = _Reuse(near=near, cand=cand, dist=dist)
         return self._cache, None
 
     def _self_pairs(
@@ -394,22 +408,31 @@ class ContactPotential:
         )  # fmt: skip
 
     def _swept_pairs(self, x: FloatArray, dx: FloatArray) -> tuple[IntArray, IntArray]:
-        """:meth:`_self_pairs` along the step ``x -> x + dx`` without margin: picked out of the
-        reused candidate set by the same box tests when that set covers the step
-        (:meth:`_Reuse.covers`; the same pairs as a fresh broad phase), else a fresh one."""
+        """:meth:`_self_pairs` along the step ``x -> x + dx`` without margin.
+
+        Picked out of a reused set that covers the step (:meth:`_NearSet.covers`) by the same
+        box tests (the same pairs as a fresh broad phase): the candidates' own pairs, or those
+        found for an earlier step. Otherwise a step of up to ``STEP_REUSE`` pads finds its own
+        pairs at ``x`` with room for the following steps (``STEP_ROOM`` times what it needs),
+        and a longer one sweeps its own boxes."""
+        if not (self.contact.self_contact and len(self.edges) > 1):
+            return _NO_PAIRS, _NO_PAIRS
         x1 = x + dx
-        cache = self._cache
-        if (
-            cache is not None
-            and self.contact.self_contact
-            and len(self.edges) > 1
-            and cache.covers(x, x1)
-        ):
-            extra = 0.5 * (self.dhat + 0.0)
-            return near_subset(
-                x, x1, self.edges, self.radius + extra, self.node_radius + extra, cache.near
-            )
-        return self._self_pairs(x, x1, 0.0)
+        known = [self._step_near]
+        if self._cache is not None:
+            known.insert(0, self._cache.near)
+        reuse = next((k for k in known if k is not None and k.covers(x, x1)), None)
+        if reuse is None:
+            delta = np.abs(dx).max(axis=0) if len(dx) else np.zeros(3)
+            need = 2.0 * float(np.sqrt(delta @ delta)) / (1.0 - 1e-6)
+            if need > STEP_REUSE * self._pad:
+                return self._self_pairs(x, x1, 0.0)
+            pad = max(STEP_ROOM * need, self._pad)
+            reuse = self._step_near = _NearSet(x.copy(), pad, self._self_pairs(x, x, pad))
+        extra = 0.5 * (self.dhat + 0.0)
+        return near_subset(
+            x, x1, self.edges, self.radius + extra, self.node_radius + extra, reuse.pairs
+        )
 
     def _build_candidates(
         self,
