@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
+from numba import njit, types
+from numba.typed import Dict
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.potential import Contact, ContactPotential, HessianBlocks
@@ -26,6 +27,11 @@ from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.sparse_cholesky import Symbolic, analyse
 
 __all__ = ["ContactTerm", "HessianPattern", "banded_to_csc"]
+
+_QUAD = types.UniTuple(types.int64, 4)
+_NO_QUADS = np.zeros((0, 4), dtype=np.int64)
+_NO_PAIR = np.zeros((0, 12, 12))
+_NO_KEYS = np.zeros(0, dtype=np.int64)
 
 #: factor growth (nonzeros of L relative to the last fresh ordering) that triggers a new one
 REORDER = 1.3
@@ -55,6 +61,17 @@ class HessianPattern:
         self._base: tuple[IntArray, IntArray] | None = None  # the base's indptr, indices
         self._base_pos: IntArray = np.zeros(0, dtype=np.int64)
         self._sym: Symbolic | None = None
+        self._forget_positions()
+
+    def _forget_positions(self) -> None:
+        """Empty the remembered data positions of pair blocks (the union changed)."""
+        # pair (node indices) -> row of self._slots: the data position of each of its 144
+        # entries in the loop order of _scatter_blocks (-1: not a free coordinate, -2: not in
+        # the pattern)
+        self._slot_of = Dict.empty(key_type=_QUAD, value_type=types.int64)
+        self._slots: IntArray = np.empty((0, 144), dtype=np.int64)
+        self._used = np.zeros(1, dtype=np.int64)
+        self._slot_coords: IntArray | None = None  # the coord_reduced they hold for
 
     def add(
         self, base: sp.csc_matrix, contact: HessianBlocks, coord_reduced: IntArray
@@ -79,14 +96,13 @@ class HessianPattern:
         assert self._union is not None
         blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
         cdata = np.zeros(len(self._keys))
-        no_keys = np.zeros(0, dtype=np.int64)
-        count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, no_keys)
+        count = self._scatter(coord_reduced, contact, cdata)
         if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
             keys = np.empty(144 * len(contact.quads) + 9 * len(contact.nodes), dtype=np.int64)
             found = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, keys)
             self._grow(base, np.unique(keys[:found]), n)
             cdata = np.zeros(len(self._keys))
-            count = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, no_keys)
+            count = self._scatter(coord_reduced, contact, cdata)
         if count == 0:
             return None
         data = cdata
@@ -94,6 +110,32 @@ class HessianPattern:
         assert self._sym is not None
         indices, indptr = self._union
         return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)
+
+    def _scatter(self, coord_reduced: IntArray, contact: HessianBlocks, out: FloatArray) -> int:
+        """:func:`_scatter_blocks` into ``out``, the pair blocks through the remembered data
+        positions of their entries (found once per pair and pattern, not per entry and call);
+        the same additions in the same order."""
+        assert self._union is not None
+        indices, indptr = self._union
+        if self._slot_coords is None or not np.array_equal(self._slot_coords, coord_reduced):
+            self._forget_positions()
+            self._slot_coords = coord_reduced.copy()
+        need = int(self._used[0]) + len(contact.quads)
+        if need > len(self._slots):
+            grown = np.empty((max(need, 2 * len(self._slots), 64), 144), dtype=np.int64)
+            grown[: len(self._slots)] = self._slots
+            self._slots = grown
+        count = _scatter_pairs(
+            indptr, indices, coord_reduced, contact.n_nodes, contact.quads, contact.pair, out,
+            self._slot_of, self._slots, self._used,
+        )  # fmt: skip
+        if count < 0 or not len(contact.nodes):
+            return count
+        floor = _scatter_blocks(
+            indptr, indices, coord_reduced, contact.n_nodes, _NO_QUADS, _NO_PAIR,
+            contact.nodes, contact.node, out, _NO_KEYS,
+        )  # fmt: skip
+        return -1 if floor < 0 else count + floor
 
     def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int) -> None:
         bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
@@ -113,6 +155,7 @@ class HessianPattern:
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
         self._union = (rows, indptr)
         self._keys = keys
+        self._forget_positions()
         pattern = sp.csc_matrix((np.ones(len(keys)), rows, indptr), shape=(n, n))
         # keep the ordering while the factor stays within REORDER of its size when ordered;
         # a new minimum-degree ordering costs more than the numeric factorization
@@ -304,5 +347,56 @@ def _scatter_blocks(
                             if pos < 0:
                                 return -1
                             out[pos] += v
+                        count += 1
+    return count
+
+
+@njit(cache=True)
+def _scatter_pairs(
+    indptr, indices, coord_reduced, n_nodes, quads, pair, out, slot_of, slots, used
+):  # pragma: no cover - compiled
+    """The pair blocks of :func:`_scatter_blocks` (same entries, same order of additions),
+    each pair's data positions looked up in ``slots[slot_of[pair]]`` and found (and stored
+    in row ``used[0]``, which is then advanced) on its first appearance; ``slots`` must have
+    a free row per pair. Returns the number of entries added, or -1 when one is not in the
+    pattern."""
+    count = 0
+    for p in range(quads.shape[0]):
+        key = (quads[p, 0], quads[p, 1], quads[p, 2], quads[p, 3])
+        if key in slot_of:
+            slot = slot_of[key]
+        else:
+            slot = used[0]
+            used[0] += 1
+            slot_of[key] = slot
+            e = 0
+            for a in range(4):
+                na = quads[p, a]
+                for b in range(4):
+                    nb = quads[p, b]
+                    for m in range(3):
+                        c = coord_reduced[3 * nb + m] if nb < n_nodes else -1
+                        pos = -2
+                        for k in range(3):
+                            r = coord_reduced[3 * na + k] if na < n_nodes else -1
+                            if c < 0 or r < 0:
+                                slots[slot, e] = -1
+                            else:
+                                pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                                slots[slot, e] = pos if pos >= 0 else -2
+                            e += 1
+        e = 0
+        for a in range(4):
+            for b in range(4):
+                for m in range(3):
+                    for k in range(3):
+                        t = slots[slot, e]
+                        e += 1
+                        v = pair[p, 3 * a + k, 3 * b + m]
+                        if t == -1 or v == 0.0:
+                            continue
+                        if t == -2:
+                            return -1
+                        out[t] += v
                         count += 1
     return count
