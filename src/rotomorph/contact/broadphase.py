@@ -114,45 +114,34 @@ def _near_pairs(x0, x1, edges, incident, seg_share, node_share, keys):  # pragma
     start = lo[:, axis] - share
     order = np.argsort(start)
     ptr = _key_rows(keys, ne)
-    # the boxes in sweep order, one contiguous array per coordinate (the inner loop reads them
-    # in that order)
-    lo_s = np.empty((3, m))
-    hi_s = np.empty((3, m))
+    # the boxes in sweep order, contiguous (the inner loop reads them in that order)
+    lo_s = np.empty((m, 3))
+    hi_s = np.empty((m, 3))
     share_s = np.empty(m)
     start_s = np.empty(m)
     for ii in range(m):
         i = order[ii]
         for k in range(3):
-            lo_s[k, ii] = lo[i, k]
-            hi_s[k, ii] = hi[i, k]
+            lo_s[ii, k] = lo[i, k]
+            hi_s[ii, k] = hi[i, k]
         share_s[ii] = share[i]
         start_s[ii] = start[i]
-    lx, ly, lz = lo_s[0], lo_s[1], lo_s[2]
-    hx, hy, hz = hi_s[0], hi_s[1], hi_s[2]
     seg = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
     node = np.empty((max(4 * ne, 16), 2), dtype=np.int64)
-    hits = np.empty(m, dtype=np.int64)
     ns = np.int64(0)  # not the literal 0: one compiled _grow, not one per literal
     nq = np.int64(0)
     for ii in range(m):
         i = order[ii]
-        end = hi_s[axis, ii] + share_s[ii]
-        stop = np.searchsorted(start_s, end, side="right")  # the window: start_s <= end
-        # the box test of _boxes_near without branches (the same value: a gap of at least
-        # the reach along one axis makes the sum of squares at least the reach squared)
-        nh = 0
-        for jj in range(ii + 1, stop):
-            reach = share_s[ii] + share_s[jj]
-            gx = max(lx[jj] - hx[ii], lx[ii] - hx[jj], 0.0)
-            gy = max(ly[jj] - hy[ii], ly[ii] - hy[jj], 0.0)
-            gz = max(lz[jj] - hz[ii], lz[ii] - hz[jj], 0.0)
-            hits[nh] = jj
-            nh += gx * gx + gy * gy + gz * gz < reach * reach
+        end = hi_s[ii, axis] + share_s[ii]
         i_node = i >= ne
-        for h in range(nh):
-            j = order[hits[h]]
+        for jj in range(ii + 1, m):
+            if start_s[jj] > end:
+                break
+            j = order[jj]
             if i_node and j >= ne:
                 continue  # node against node: carried by the segments
+            if not _boxes_near(lo_s, hi_s, share_s, ii, jj):
+                continue
             if not i_node and j < ne:
                 if not _excluded_in_row(keys, ptr, i, j, ne):
                     seg = _grow(seg, ns)

@@ -48,11 +48,6 @@ DEFAULT_ACTIVATION = 0.03
 #: how far (per coordinate, relative to the activation distance) a path's end may leave the
 #: boxes swept by the last step bound for its candidates to be reused (``path_is_free``)
 SWEPT_SLACK = 0.25
-#: a step bound's own broad phase at the step's start is kept for the following steps when the
-#: step moves a node at most this many candidate pads; it is padded by ``STEP_ROOM`` times what
-#: the step itself needs
-STEP_REUSE = 2.0
-STEP_ROOM = 1.5
 
 
 _NO_INT = np.zeros(0, dtype=np.int64)
@@ -298,8 +293,6 @@ class ContactPotential:
         self._lag: FrictionLag | None = None
         # broad-phase cache: reference positions, padded margin, candidates found there
         self._cache: _Reuse | None = None
-        # own pairs found for an earlier step bound, reused by later ones they cover
-        self._step_near: _NearSet | None = None
         # the last step bound's start, end and candidates (reused by path_is_free)
         self._swept: tuple[FloatArray, FloatArray, _Candidates] | None = None
         self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
@@ -408,31 +401,22 @@ class ContactPotential:
         )  # fmt: skip
 
     def _swept_pairs(self, x: FloatArray, dx: FloatArray) -> tuple[IntArray, IntArray]:
-        """:meth:`_self_pairs` along the step ``x -> x + dx`` without margin.
-
-        Picked out of a reused set that covers the step (:meth:`_NearSet.covers`) by the same
-        box tests (the same pairs as a fresh broad phase): the candidates' own pairs, or those
-        found for an earlier step. Otherwise a step of up to ``STEP_REUSE`` pads finds its own
-        pairs at ``x`` with room for the following steps (``STEP_ROOM`` times what it needs),
-        and a longer one sweeps its own boxes."""
-        if not (self.contact.self_contact and len(self.edges) > 1):
-            return _NO_PAIRS, _NO_PAIRS
+        """:meth:`_self_pairs` along the step ``x -> x + dx`` without margin: picked out of the
+        reused candidate set by the same box tests when that set covers the step
+        (:meth:`_NearSet.covers`; the same pairs as a fresh broad phase), else a fresh one."""
         x1 = x + dx
-        known = [self._step_near]
-        if self._cache is not None:
-            known.insert(0, self._cache.near)
-        reuse = next((k for k in known if k is not None and k.covers(x, x1)), None)
-        if reuse is None:
-            delta = np.abs(dx).max(axis=0) if len(dx) else np.zeros(3)
-            need = 2.0 * float(np.sqrt(delta @ delta)) / (1.0 - 1e-6)
-            if need > STEP_REUSE * self._pad:
-                return self._self_pairs(x, x1, 0.0)
-            pad = max(STEP_ROOM * need, self._pad)
-            reuse = self._step_near = _NearSet(x.copy(), pad, self._self_pairs(x, x, pad))
-        extra = 0.5 * (self.dhat + 0.0)
-        return near_subset(
-            x, x1, self.edges, self.radius + extra, self.node_radius + extra, reuse.pairs
-        )
+        cache = self._cache
+        if (
+            cache is not None
+            and self.contact.self_contact
+            and len(self.edges) > 1
+            and cache.near.covers(x, x1)
+        ):
+            extra = 0.5 * (self.dhat + 0.0)
+            return near_subset(
+                x, x1, self.edges, self.radius + extra, self.node_radius + extra, cache.near.pairs
+            )
+        return self._self_pairs(x, x1, 0.0)
 
     def _build_candidates(
         self,
