@@ -127,7 +127,8 @@ def pair_barrier(
         dist[p] = np.sqrt(D)
         if D >= reach * reach:
             continue  # inactive: zero energy, its hloc block is left unwritten
-        D = segment_distance2(x[i0], x[i1], x[j0], x[j1], no, g, h)
+        if need_grad or need_hess:  # its gradient (D itself: the same value as above)
+            D = segment_distance2(x[i0], x[i1], x[j0], x[j1], no, g, h)
         zhat = (2.0 * dmin[p] + dhat) * dhat
         b, b1, b2 = barrier(D - dmin[p] * dmin[p], zhat)
         if b == 0.0 and b1 == 0.0:

@@ -152,14 +152,17 @@ def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cove
     Coordinates are ordered ``p0, p1, q0, q1`` (3 each).
     """
     s, t = closest_parameters(p0, p1, q0, q1)
-    w = np.array([1.0 - s, s, -(1.0 - t), -t])
-    r = np.empty(3)
-    a = np.empty(3)
-    b = np.empty(3)
-    for k in range(3):
-        a[k] = p1[k] - p0[k]
-        b[k] = q1[k] - q0[k]
-        r[k] = p0[k] + s * a[k] - q0[k] - t * b[k]
+    # scalars and tuples, not small arrays: no allocation per call (the same operations)
+    w = (1.0 - s, s, -(1.0 - t), -t)
+    a0, a1, a2 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    b0, b1, b2 = q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]
+    a = (a0, a1, a2)
+    b = (b0, b1, b2)
+    r = (
+        p0[0] + s * a0 - q0[0] - t * b0,
+        p0[1] + s * a1 - q0[1] - t * b1,
+        p0[2] + s * a2 - q0[2] - t * b2,
+    )
     D = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
     for n in range(4):
         for k in range(3):
@@ -180,8 +183,8 @@ def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cove
         s_free = False  # parallel branch: s is held at its end
     if not (s_free or t_free):
         return D
-    cs = np.array([-1.0, 1.0, 0.0, 0.0])
-    ct = np.array([0.0, 0.0, -1.0, 1.0])
+    cs = (-1.0, 1.0, 0.0, 0.0)
+    ct = (0.0, 0.0, -1.0, 1.0)
     Gs = np.empty(12)
     Gt = np.empty(12)
     for n in range(4):
