@@ -77,45 +77,42 @@ def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _stable_by(key, n, order):  # pragma: no cover - compiled
+    """``order`` rearranged so that ``key[order]`` ascends (``0 <= key < n``), ties kept in
+    their order (one counting-sort pass)."""
+    start = np.zeros(n + 1, dtype=np.int64)
+    for q in order:
+        start[key[q] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    out = np.empty_like(order)
+    for q in order:
+        out[start[key[q]]] = q
+        start[key[q]] += 1
+    return out
+
+
+@njit(cache=True)
 def _permuted_upper(n, indptr, indices, inv):  # pragma: no cover - compiled
     """Upper triangle of ``B = A[perm][:, perm]`` in CSC (rows ascending; repeated entries in
     their order in ``A``) and the position ``src`` of each entry in ``A``'s data: a stable
     counting sort by row, then by column."""
-    row_count = np.zeros(n + 1, dtype=np.int64)
+    rows = np.empty(indptr[n], dtype=np.int64)
+    cols = np.empty(indptr[n], dtype=np.int64)
+    src = np.empty(indptr[n], dtype=np.int64)
+    m = 0
     for col in range(n):
-        j = inv[col]
         for p in range(indptr[col], indptr[col + 1]):
-            i = inv[indices[p]]
-            if i <= j:
-                row_count[i + 1] += 1
-    for i in range(n):
-        row_count[i + 1] += row_count[i]
-    m = row_count[n]
-    by_row = np.empty(m, dtype=np.int64)
-    col_of = np.empty(m, dtype=np.int64)
-    slot = row_count[:-1].copy()
-    col_count = np.zeros(n + 1, dtype=np.int64)
-    for col in range(n):
-        j = inv[col]
-        for p in range(indptr[col], indptr[col + 1]):
-            i = inv[indices[p]]
-            if i <= j:
-                by_row[slot[i]] = p
-                col_of[slot[i]] = j
-                slot[i] += 1
-                col_count[j + 1] += 1
-    for j in range(n):
-        col_count[j + 1] += col_count[j]
-    bp = col_count.copy()
-    bi = np.empty(m, dtype=np.int64)
-    src = np.empty(m, dtype=np.int64)
+            if inv[indices[p]] <= inv[col]:
+                rows[m], cols[m], src[m] = inv[indices[p]], inv[col], p
+                m += 1
+    order = _stable_by(cols, n, _stable_by(rows, n, np.arange(m)))
+    bp = np.zeros(n + 1, dtype=np.int64)
     for q in range(m):
-        j = col_of[q]
-        p = by_row[q]
-        bi[col_count[j]] = inv[indices[p]]
-        src[col_count[j]] = p
-        col_count[j] += 1
-    return bp, bi, src
+        bp[cols[q] + 1] += 1
+    for j in range(n):
+        bp[j + 1] += bp[j]
+    return bp, rows[order], src[order]
 
 
 def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
