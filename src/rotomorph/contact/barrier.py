@@ -23,11 +23,13 @@ from numba import njit
 
 from rotomorph.contact.distance import (
     BOUND_MARGIN,
+    PARALLEL,
+    closest_parameters,
     distance_bound,
     pair_distance2,
     segment_distance2,
 )
-from rotomorph.contact.psd import psd_project
+from rotomorph.contact.psd import psd_project, psd_project_in
 
 
 @njit(cache=True)
@@ -90,6 +92,102 @@ def cross_norm2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - co
 
 
 @njit(cache=True)
+def _add_column(Q, c, v, r):  # pragma: no cover - compiled
+    """Column ``c`` of ``Q`` := ``v`` orthogonalized against columns ``0..c-1`` (orthonormal)
+    twice (classical Gram–Schmidt with reorthogonalization) and normalized; when nothing of
+    ``v`` is left, the first unit vector that leaves enough. ``r`` (n,): work."""
+    n = Q.shape[0]
+    for trial in range(n + 1):
+        for i in range(n):
+            r[i] = v[i] if trial == 0 else (1.0 if i == trial - 1 else 0.0)
+        for _ in range(2):
+            for j in range(c):
+                t = 0.0
+                for i in range(n):
+                    t += Q[i, j] * r[i]
+                for i in range(n):
+                    r[i] -= t * Q[i, j]
+        nr = 0.0
+        for i in range(n):
+            nr += r[i] * r[i]
+        nr = np.sqrt(nr)
+        if (trial == 0 and nr > 0.0) or nr > 0.5:
+            for i in range(n):
+                Q[i, c] = r[i] / nr
+            return
+
+
+@njit(cache=True)
+def _project_unmollified(
+    p0, p1, q0, q1, c, b1, b2, H, out, Q, QH, V4, V5, d, e, gs, gt, r
+):  # pragma: no cover - compiled
+    """``out`` = the positive semidefinite projection of ``H``, the barrier Hessian
+    ``c (b'' g gᵀ + b' ∇²D)`` of a pair without mollifier term (``g = 2 w ⊗ r``), from the
+    structure of ``∇²D`` (:mod:`rotomorph.contact.distance`: ``2 w wᵀ ⊗ I₃`` less a Schur
+    complement in ``G_s`` and/or ``G_t`` when a closest-point parameter lies inside its
+    segment; the same tests decide which):
+
+    * no parameter inside (two points closest): ``H = c (w wᵀ) ⊗ (4 b'' r rᵀ + 2 b' I₃)`` has
+      the eigenvalue ``c |w|² (4 b'' D + 2 b')`` on ``w ⊗ r`` and ``2 c |w|² b'`` on the two
+      ``w ⊗ r⊥``, all others 0: the projection in closed form;
+    * else ``H``'s range lies in the span of ``w ⊗ e_k`` (k = 1..3) and ``G_s``, ``G_t`` (4
+      or 5 dimensions), where its eigen-decomposition is done (:func:`psd_project_in`).
+
+    The same matrix as the eigen-decomposition of the whole 12 x 12 block, to round-off.
+    ``Q`` (12, 5), ``QH`` (5, 12), ``V4``, ``V5``, ``d``, ``e`` (>= 5), ``gs``, ``gt``, ``r``
+    (12,): work arrays. Returns False when the eigen-decomposition failed.
+    """
+    s, t = closest_parameters(p0, p1, q0, q1)
+    w = (1.0 - s, s, -(1.0 - t), -t)
+    a = (p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2])
+    b = (q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2])
+    rr = (
+        p0[0] + s * a[0] - q0[0] - t * b[0],
+        p0[1] + s * a[1] - q0[1] - t * b[1],
+        p0[2] + s * a[2] - q0[2] - t * b[2],
+    )
+    A = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
+    E = b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
+    Bab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    s_free = A > 1e-300 and 0.0 < s < 1.0
+    t_free = E > 1e-300 and 0.0 < t < 1.0
+    if s_free and t_free and A * E - Bab * Bab <= PARALLEL * A * E:
+        s_free = False  # as segment_distance2: s held at its end
+    if not (s_free or t_free):
+        D = rr[0] * rr[0] + rr[1] * rr[1] + rr[2] * rr[2]
+        along = c * max(4.0 * b2 * D + 2.0 * b1, 0.0) / D
+        across = c * max(2.0 * b1, 0.0)
+        for n in range(4):
+            for m in range(4):
+                ww = w[n] * w[m]
+                for k in range(3):
+                    for j in range(3):
+                        v = along * ww * rr[k] * rr[j]
+                        if across != 0.0:
+                            v += across * ww * ((1.0 if k == j else 0.0) - rr[k] * rr[j] / D)
+                        out[3 * n + k, 3 * m + j] = v
+        return True
+    cs = (-1.0, 1.0, 0.0, 0.0)
+    ct = (0.0, 0.0, -1.0, 1.0)
+    nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2] + w[3] * w[3])
+    for n in range(4):
+        for k in range(3):
+            gs[3 * n + k] = 2.0 * (w[n] * a[k] + cs[n] * rr[k])
+            gt[3 * n + k] = -2.0 * (w[n] * b[k] + ct[n] * rr[k])
+            for col in range(3):
+                Q[3 * n + k, col] = w[n] / nw if col == k else 0.0
+    k = 3
+    if s_free:
+        _add_column(Q, k, gs, r)
+        k += 1
+    if t_free:
+        _add_column(Q, k, gt, r)
+        k += 1
+    V = V5 if k == 5 else V4
+    return psd_project_in(H, out, Q[:, :k], QH[:k], V, d[:k], e[:k])
+
+
+@njit(cache=True)
 def pair_barrier(
     x, pairs, dmin, weight, mollify, dhat, kappa, need_grad, need_hess, grad, hloc, dist
 ):  # pragma: no cover - compiled
@@ -116,6 +214,13 @@ def pair_barrier(
     vecs = np.empty((12, 12))  # work arrays of the projection
     vals = np.empty(12)
     off = np.empty(12)
+    q5 = np.empty((12, 5))  # the range of a Hessian without mollifier term
+    qh = np.empty((5, 12))
+    v4 = np.empty((4, 4))
+    v5 = np.empty((5, 5))
+    gs = np.empty(12)
+    gt = np.empty(12)
+    rw = np.empty(12)
     for p in range(pairs.shape[0]):
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]
         reach = dmin[p] + dhat
@@ -163,7 +268,17 @@ def pair_barrier(
                         v += b * (m2 * gx[i] * gx[j] + m1 * hx[i, j])
                     hloc[p, i, j] = c * v
             if need_hess == 2:
-                psd_project(hloc[p], hloc[p], vecs, vals, off)
+                ok = False
+                if m1 == 0.0 and m2 == 0.0:  # from the Hessian's structure (4-5 dimensions)
+                    vecs[:, :] = hloc[p]
+                    ok = _project_unmollified(
+                        x[i0], x[i1], x[j0], x[j1], c * m, b1, b2, vecs, hloc[p], q5, qh, v4,
+                        v5, vals, off, gs, gt, rw,
+                    )  # fmt: skip
+                    if not ok:
+                        hloc[p] = vecs
+                if not ok:  # a mollifier term (or a failed projection): all 12 dimensions
+                    psd_project(hloc[p], hloc[p], vecs, vals, off)
     return energy
 
 

@@ -194,3 +194,48 @@ def psd_project(h, out, V, d, e):  # pragma: no cover - compiled
             for i in range(n):
                 for j in range(n):
                     out[i, j] += d[k] * (V[i, k] * V[j, k])
+
+
+@njit(cache=True)
+def psd_project_in(h, out, Q, QH, V, d, e):  # pragma: no cover - compiled
+    """``out`` = the projection of ``h`` (n, n, symmetric) when the orthonormal columns of
+    ``Q`` (n, k) span its range: ``Q (Qᵀ h Q)₊ Qᵀ``, the eigen-decomposition done on the
+    k x k matrix ``Qᵀ h Q`` (``h = Q Qᵀ h Q Qᵀ``, so both have the same non-zero eigenvalues and
+    the eigenvectors of ``h`` are ``Q`` times those of the small one). ``QH`` (k, n), ``V``
+    (k, k), ``d`` and ``e`` (k,) are work arrays; ``out`` must not be ``h``. Returns False
+    (``out`` not written) when ``h`` is not finite or an eigenvalue does not converge."""
+    n, k = Q.shape
+    for a in range(k):
+        for j in range(n):
+            t = 0.0
+            for i in range(n):
+                t += Q[i, a] * h[i, j]
+            QH[a, j] = t
+    finite = True
+    for a in range(k):
+        for b in range(a, k):
+            t = 0.0
+            for j in range(n):
+                t += QH[a, j] * Q[j, b]
+            V[a, b] = t
+            V[b, a] = t
+            finite = finite and np.isfinite(t)
+    if not finite:
+        return False
+    _tridiagonalize(V, d, e)
+    if not _ql_implicit(V, d, e):
+        return False
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 0.0
+    for c in range(k):
+        if d[c] > 0.0:
+            for i in range(n):  # the eigenvector in the full space, into row c of QH
+                t = 0.0
+                for a in range(k):
+                    t += Q[i, a] * V[a, c]
+                QH[c, i] = t
+            for i in range(n):
+                for j in range(n):
+                    out[i, j] += d[c] * (QH[c, i] * QH[c, j])
+    return True
