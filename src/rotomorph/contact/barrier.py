@@ -23,8 +23,7 @@ from numba import njit
 
 from rotomorph.contact.distance import (
     BOUND_MARGIN,
-    PARALLEL,
-    closest_parameters,
+    closest_terms,
     distance_bound,
     pair_distance2,
     segment_distance2,
@@ -137,22 +136,7 @@ def _project_unmollified(
     ``Q`` (12, 5), ``QH`` (5, 12), ``V4``, ``V5``, ``d``, ``e`` (>= 5), ``gs``, ``gt``, ``r``
     (12,): work arrays. Returns False when the eigen-decomposition failed.
     """
-    s, t = closest_parameters(p0, p1, q0, q1)
-    w = (1.0 - s, s, -(1.0 - t), -t)
-    a = (p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2])
-    b = (q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2])
-    rr = (
-        p0[0] + s * a[0] - q0[0] - t * b[0],
-        p0[1] + s * a[1] - q0[1] - t * b[1],
-        p0[2] + s * a[2] - q0[2] - t * b[2],
-    )
-    A = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
-    E = b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
-    Bab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-    s_free = A > 1e-300 and 0.0 < s < 1.0
-    t_free = E > 1e-300 and 0.0 < t < 1.0
-    if s_free and t_free and A * E - Bab * Bab <= PARALLEL * A * E:
-        s_free = False  # as segment_distance2: s held at its end
+    _, _, w, a, b, rr, _, _, s_free, t_free = closest_terms(p0, p1, q0, q1)
     if not (s_free or t_free):
         D = rr[0] * rr[0] + rr[1] * rr[1] + rr[2] * rr[2]
         along = c * max(4.0 * b2 * D + 2.0 * b1, 0.0) / D

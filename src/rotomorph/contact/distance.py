@@ -146,23 +146,38 @@ def _d2(A, B, C, E, F, s, t, R):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - compiled
-    """Squared distance ``D``; fills ``grad`` (12,) and, if ``need_hess``, ``hess`` (12, 12).
-
-    Coordinates are ordered ``p0, p1, q0, q1`` (3 each).
-    """
+def closest_terms(p0, p1, q0, q1):  # pragma: no cover - compiled
+    """The terms of :func:`segment_distance2` at the closest points, as scalars and tuples (no
+    allocation): ``s, t, w, a, b, r, A, E, s_free, t_free`` with ``w = (1-s, s, -(1-t), -t)``,
+    ``a = p1 - p0``, ``b = q1 - q0``, ``r = p(s) - q(t)``, ``A = a.a``, ``E = b.b`` and which
+    parameters lie inside their segment (the free set of the Hessian; of two nearly parallel
+    free ones, ``s`` is held at its end)."""
     s, t = closest_parameters(p0, p1, q0, q1)
-    # scalars and tuples, not small arrays: no allocation per call (the same operations)
     w = (1.0 - s, s, -(1.0 - t), -t)
     a0, a1, a2 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
     b0, b1, b2 = q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]
-    a = (a0, a1, a2)
-    b = (b0, b1, b2)
     r = (
         p0[0] + s * a0 - q0[0] - t * b0,
         p0[1] + s * a1 - q0[1] - t * b1,
         p0[2] + s * a2 - q0[2] - t * b2,
     )
+    A = a0 * a0 + a1 * a1 + a2 * a2
+    E = b0 * b0 + b1 * b1 + b2 * b2
+    Bab = a0 * b0 + a1 * b1 + a2 * b2
+    s_free = A > 1e-300 and 0.0 < s < 1.0
+    t_free = E > 1e-300 and 0.0 < t < 1.0
+    if s_free and t_free and A * E - Bab * Bab <= PARALLEL * A * E:
+        s_free = False  # parallel branch: s is held at its end
+    return s, t, w, (a0, a1, a2), (b0, b1, b2), r, A, E, s_free, t_free
+
+
+@njit(cache=True)
+def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cover - compiled
+    """Squared distance ``D``; fills ``grad`` (12,) and, if ``need_hess``, ``hess`` (12, 12).
+
+    Coordinates are ordered ``p0, p1, q0, q1`` (3 each).
+    """
+    _, _, w, a, b, r, A, E, s_free, t_free = closest_terms(p0, p1, q0, q1)
     D = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
     for n in range(4):
         for k in range(3):
@@ -174,13 +189,6 @@ def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cove
             for k in range(3):
                 for j in range(3):
                     hess[3 * n + k, 3 * m + j] = 2.0 * w[n] * w[m] if k == j else 0.0
-    A = a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
-    E = b[0] * b[0] + b[1] * b[1] + b[2] * b[2]
-    Bab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-    s_free = A > 1e-300 and 0.0 < s < 1.0
-    t_free = E > 1e-300 and 0.0 < t < 1.0
-    if s_free and t_free and A * E - Bab * Bab <= PARALLEL * A * E:
-        s_free = False  # parallel branch: s is held at its end
     if not (s_free or t_free):
         return D
     cs = (-1.0, 1.0, 0.0, 0.0)
@@ -193,6 +201,7 @@ def segment_distance2(p0, p1, q0, q1, need_hess, grad, hess):  # pragma: no cove
             Gt[3 * n + k] = -2.0 * (w[n] * b[k] + ct[n] * r[k])
     if s_free and t_free:
         # inverse of f_uu = 2 [[A, -B], [-B, E]]
+        Bab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
         det = 2.0 * (A * E - Bab * Bab)
         iss, itt, ist = E / det, A / det, Bab / det
         for i in range(12):
