@@ -133,3 +133,28 @@ def test_reused_candidates_give_the_pairs_of_a_fresh_broad_phase(seed):
             assert pot.step_bound(x, dx) == ContactPotential(contact, net).step_bound(x, dx)
     assert 50 < reuses < 140  # both reuse and fresh broad phases, many times
     assert active > 100 and steps_reused > 200 and swept > 5000
+
+
+def test_step_bounds_from_one_start_share_its_distances(rng):
+    """The conservative advancement of several steps from one start over the same pairs
+    reuses the distances at the start (filled in as first needed, exactly the pairs'
+    distances there): every bound equals one computed from scratch."""
+    from rotomorph.contact.ccd import pair_step_bound
+
+    net, base = _grid(rng)
+    pot = ContactPotential(Contact(radius=0.2), net)
+    x = np.ascontiguousarray(base)
+    cand = pot._build_candidates(x, 0.0, step=_shift(rng, x.shape, 2.0))
+    quads, dmin = cand.quads, cand.dmin
+    shared = np.full(len(quads), np.nan)
+    bounds = []
+    for scale in (0.02, 0.1, 0.3, 0.6) * 3:
+        dx = np.ascontiguousarray(_shift(rng, x.shape, scale))
+        for close in (0.9, 1.0):
+            t = pair_step_bound(x, dx, quads, dmin, close, 100_000, shared)
+            fresh = pair_step_bound(x, dx, quads, dmin, close, 100_000, np.full(len(quads), np.nan))
+            assert t == fresh
+            bounds.append(t)
+    known = ~np.isnan(shared)
+    assert known.sum() > 20 and len(set(bounds)) > 4 and min(bounds) < 1.0
+    assert np.array_equal(shared[known], pair_distances(x, quads)[known])

@@ -28,13 +28,18 @@ def _distance(x0, dx, t, i0, i1, j0, j1):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragma: no cover
+def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps, dist0):  # pragma: no cover
     """Largest ``t`` in [0, 1] such that no pair comes within ``dmin`` on ``[0, t]``.
 
     A pair stops the advance once it has closed ``close_fraction`` of its initial gap
     (``close_fraction = 1``: only contact or ``max_substeps`` stop it). Returns 0 when a pair
     starts at or inside contact. Pairs are advanced in the order of their first safe advance,
-    so the bound falls early and the pairs that cannot close before it are skipped.
+    so the bound falls early and the pairs that cannot close before it are skipped (the bound
+    is the smallest stopping time over the pairs, whatever the order).
+
+    ``dist0`` (P,): each pair's distance at ``x0`` where known, NaN where not; the distances
+    this call needs are computed and stored there, so steps from the same ``x0`` over the same
+    pairs (a line search's path checks) reuse them.
     """
     P = pairs.shape[0]
     gap0 = np.empty(P)
@@ -64,12 +69,15 @@ def pair_step_bound(x0, dx, pairs, dmin, close_fraction, max_substeps):  # pragm
             gap0[p] = bound  # cannot close even its first advance within the whole step
             first[p] = np.inf
             continue
-        gap0[p] = _distance(x0, dx, 0.0, i0, i1, j0, j1) - dmin[p]
+        if np.isnan(dist0[p]):
+            dist0[p] = _distance(x0, dx, 0.0, i0, i1, j0, j1)  # the same at t = 0 for any dx
+        gap0[p] = dist0[p] - dmin[p]
         if gap0[p] <= 0.0:
             return 0.0
         first[p] = ADVANCE * gap0[p] / rate[p] if rate[p] > 0.0 else np.inf
     tmin = 1.0
-    for p in np.argsort(first):
+    closing = np.flatnonzero(first < tmin)  # the others cannot close within the whole step
+    for p in closing[np.argsort(first[closing])]:
         if first[p] >= tmin:
             break  # this pair and all after it cannot close within the current bound
         i0, i1, j0, j1 = pairs[p, 0], pairs[p, 1], pairs[p, 2], pairs[p, 3]

@@ -294,7 +294,8 @@ class ContactPotential:
         # broad-phase cache: reference positions, padded margin, candidates found there
         self._cache: _Reuse | None = None
         # the last step bound's start, end and candidates (reused by path_is_free)
-        self._swept: tuple[FloatArray, FloatArray, _Candidates] | None = None
+        # (with each candidate pair's distance at the start, NaN until a bound needs it)
+        self._swept: tuple[FloatArray, FloatArray, _Candidates, FloatArray] | None = None
         self._pad = 0.5 * dmin_small  # reuse a candidate set over node motions up to a radius
         deg = np.bincount(edges.ravel(), minlength=n)
         inc = -np.ones((n, max(int(deg.max()), 1)), dtype=np.int64)
@@ -596,17 +597,24 @@ class ContactPotential:
         if disp == 0.0:
             return 1.0
         cand = self._build_candidates(x, 0.0, step=dx, own=self._swept_pairs(x, dx))
-        self._swept = (x.copy(), x + dx, cand)
-        return self._bound_on(x, dx, cand, close_fraction)
+        dist0 = np.full(len(cand.quads), np.nan)
+        self._swept = (x.copy(), x + dx, cand, dist0)
+        return self._bound_on(x, dx, cand, close_fraction, dist0)
 
     def _bound_on(
-        self, x: FloatArray, dx: FloatArray, cand: _Candidates, close_fraction: float
+        self,
+        x: FloatArray,
+        dx: FloatArray,
+        cand: _Candidates,
+        close_fraction: float,
+        dist0: FloatArray,
     ) -> float:
-        """:meth:`step_bound` over the candidate pairs ``cand`` of the step."""
+        """:meth:`step_bound` over the candidate pairs ``cand`` of the step; ``dist0``: their
+        distances at ``x`` where known (NaN: not yet; filled as needed)."""
         xe = self._extended(x)
         dxe = np.zeros_like(xe)
         dxe[: self.n_nodes] = dx
-        t = pair_step_bound(xe, dxe, cand.quads, cand.dmin, close_fraction, MAX_SUBSTEPS)
+        t = pair_step_bound(xe, dxe, cand.quads, cand.dmin, close_fraction, MAX_SUBSTEPS, dist0)
         for f, (nodes, dmin, _) in zip(self._floors, cand.floors, strict=True):
             bound = plane_step_bound(
                 xe, dxe, nodes, np.asarray(f.normal), f.height, dmin, close_fraction
@@ -629,10 +637,10 @@ class ContactPotential:
         x1 = np.ascontiguousarray(x1, dtype=float)
         swept = self._swept
         if swept is not None and swept[0].shape == x0.shape and np.array_equal(swept[0], x0):
-            start, end, cand = swept
+            start, end, cand, dist0 = swept
             outside = np.maximum(np.minimum(start, end) - x1, x1 - np.maximum(start, end))
             if len(x1) == 0 or float(outside.max()) <= SWEPT_SLACK * self.dhat:
-                return self._bound_on(x0, x1 - x0, cand, 1.0) >= 1.0
+                return self._bound_on(x0, x1 - x0, cand, 1.0, dist0) >= 1.0
         return self.step_bound(x0, x1 - x0, close_fraction=1.0) >= 1.0
 
     # ------------------------------------------------------------------ measures

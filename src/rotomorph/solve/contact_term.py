@@ -83,16 +83,11 @@ class HessianPattern:
         if self._n != n:
             self._reset(n)
         base = base.tocsc()
-        if not base.has_sorted_indices:
-            base = base.sorted_indices()
-        known = self._base
-        if (
-            self._union is None
-            or known is None
-            or not np.array_equal(known[0], base.indptr)
-            or not np.array_equal(known[1], base.indices)
-        ):
-            self._grow(base, np.zeros(0, dtype=np.int64), n)
+        if not self._known_base(base):  # (the known base is sorted: no need to check that)
+            if not base.has_sorted_indices:
+                base = base.sorted_indices()
+            if not self._known_base(base):
+                self._grow(base, np.zeros(0, dtype=np.int64), n)
         assert self._union is not None
         blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
         cdata = np.zeros(len(self._keys))
@@ -106,10 +101,20 @@ class HessianPattern:
         if count == 0:
             return None
         data = cdata
-        data[self._base_pos] += base.data
+        _add_at(data, self._base_pos, base.data)  # data[pos] += base.data, compiled
         assert self._sym is not None
         indices, indptr = self._union
         return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)
+
+    def _known_base(self, base: sp.csc_matrix) -> bool:
+        """Whether ``base`` has the pattern of the base the union was last grown with."""
+        known = self._base
+        return (
+            self._union is not None
+            and known is not None
+            and np.array_equal(known[0], base.indptr)
+            and np.array_equal(known[1], base.indices)
+        )
 
     def _scatter(self, coord_reduced: IntArray, contact: HessianBlocks, out: FloatArray) -> int:
         """:func:`_scatter_blocks` into ``out``, the pair blocks through the remembered data
@@ -400,3 +405,10 @@ def _scatter_pairs(
                         out[t] += v
                         count += 1
     return count
+
+
+@njit(cache=True)
+def _add_at(out, pos, values):  # pragma: no cover - compiled
+    """``out[pos] += values`` for distinct positions ``pos``."""
+    for k in range(pos.shape[0]):
+        out[pos[k]] += values[k]
