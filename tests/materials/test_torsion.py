@@ -90,3 +90,18 @@ def test_janus_torsion_table(m: float, c_norm: float, c_gp: float, f_tau: float)
         lambda xy, a: np.where(a[:, None], g0 * np.column_stack([-xy[:, 1], xy[:, 0]]), 0.0)
     )
     assert tau / g0 == pytest.approx(f_tau, abs=2e-3)
+
+
+def test_torsion_is_solved_only_for_states_with_eigen_shear() -> None:
+    # print states without a director helix (omega* = 0) have no eigen-shear: no natural
+    # twist, and the warping problem is not solved for them; a helix needs it and gets the
+    # torsion FEM's twist
+    section = filament_section(0.3, 7.3, 1.1)  # moduli of its own: a fresh cached section
+    _, _, dtau = section.natural_strains(0.0, -0.2, 0.1, 0.01)
+    assert dtau[0] == 0.0 and "torsion" not in section.__dict__
+    _, _, dtau = section.natural_strains(0.7, -0.2, 0.1, 0.01)
+    assert "torsion" in section.__dict__
+    _, gamma = section.eigenfields(0.7, -0.2, 0.1, 0.01)
+    np.testing.assert_allclose(dtau, section.torsion.natural_twist(gamma), rtol=1e-14)
+    assert abs(dtau[0]) > 1e-3
+    assert section.twist_stiffness == section.torsion.torsion_constant > 0

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -69,13 +69,19 @@ class FilamentSection:
     radius: float
     mesh: SectionMesh
     axial: AxialSection
-    torsion: TorsionSection
+    shear_moduli: tuple[float, float]  # G of the active and the passive phase (MPa)
     _solved: dict[bytes, FloatArray] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
     _curved: dict[bytes, FloatArray] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+
+    @cached_property
+    def torsion(self) -> TorsionSection:
+        """Saint-Venant torsion of the section (warping FEM), solved on first use: natural
+        strains of print states without eigen-shear (no director helix) do not need it."""
+        return torsion_section(self.mesh, phase_constant(*self.shear_moduli))
 
     @property
     def solved_states(self) -> int:
@@ -205,12 +211,10 @@ class FilamentSection:
     def _solve_states(self, states: FloatArray) -> FloatArray:
         """``(m, 4)`` rows (ε_c, κ1, κ2, Δτ) of distinct print states ``(m, 4)``."""
         eps_zz, gamma = self.eigenfields(*states.T)
+        # no eigen-shear (ω* = 0 everywhere): no natural twist, and no torsion solve for it
+        twist = self.torsion.natural_twist(gamma) if np.any(gamma) else np.zeros(len(states))
         return np.column_stack(
-            [
-                self.axial.natural_strain(eps_zz),
-                self.axial.natural_curvature(eps_zz),
-                self.torsion.natural_twist(gamma),
-            ]
+            [self.axial.natural_strain(eps_zz), self.axial.natural_curvature(eps_zz), twist]
         )
 
 
@@ -249,8 +253,7 @@ def _cached(
 ) -> FilamentSection:
     mesh = _mesh(radius, active_fraction, resolution)
     axial = axial_section(mesh, phase_constant(e_active, e_passive))
-    torsion = torsion_section(mesh, phase_constant(g_active, g_passive))
-    return FilamentSection(radius, mesh, axial, torsion)
+    return FilamentSection(radius, mesh, axial, (g_active, g_passive))
 
 
 def filament_section(
