@@ -132,7 +132,7 @@ def test_reused_candidates_give_the_pairs_of_a_fresh_broad_phase(seed):
             swept += len(seg0) + len(node0)
             assert pot.step_bound(x, dx) == ContactPotential(contact, net).step_bound(x, dx)
     assert 50 < reuses < 140  # both reuse and fresh broad phases, many times
-    assert active > 100 and steps_reused > 200 and swept > 5000
+    assert active > 100 and steps_reused > 150 and swept > 5000  # of 900 steps: both kinds
 
 
 def test_step_bounds_from_one_start_share_its_distances(rng):
