@@ -306,12 +306,18 @@ def _sparse_eigen(
     if found is not None:
         theta, vec = found
         lam = sigma + 1.0 / theta[::-1]  # the largest theta is the lowest eigenvalue
-        if not vectors and lam[0] >= -tol * scale:
-            return lam, None, extra
-        vec = vec[:, ::-1]
-        norms = np.sqrt(np.einsum("ij,i,ij->j", vec, M, vec))
-        return lam, vec / norms, extra
-    # not converged within the Lanczos basis: ARPACK's implicitly restarted Lanczos
+        if lam[0] >= -tol * scale:
+            if not vectors:
+                return lam, None, extra
+            vec = vec[:, ::-1]
+            norms = np.sqrt(np.einsum("ij,i,ij->j", vec, M, vec))
+            return lam, vec / norms, extra
+        # unstable: its modes steer the solver off the saddle (and the lift probe's start),
+        # so they come from ARPACK run to its own tolerance, as the eigenvalues' verdict does
+        # not need: a Ritz vector stopped at the eigenvalues' convergence is less accurate,
+        # and an escape along a different vector can reach another equilibrium
+    # not converged within the Lanczos basis, or unstable: ARPACK's implicitly restarted
+    # Lanczos
     lin = spla.LinearOperator((n, n), matvec=lambda v: matvec(H, np.ravel(v)), dtype=float)
     opinv = spla.LinearOperator((n, n), matvec=op_inv, dtype=float)
     kwargs = dict(k=want, M=sp.diags(M), sigma=sigma, which="LM", OPinv=opinv, v0=v0, tol=1e-8)
