@@ -418,7 +418,7 @@ class ContactPotential:
             and len(self.edges) > 1
             and cache.near.covers(x, x1)
         ):
-            extra = 0.5 * (self.dhat + 0.0)
+            extra = 0.5 * self.dhat
             return near_subset(
                 x, x1, self.edges, self.radius + extra, self.node_radius + extra, cache.near.pairs
             )

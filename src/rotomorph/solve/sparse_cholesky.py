@@ -22,7 +22,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 
 from rotomorph._typing import FloatArray, IntArray
-from rotomorph.solve.supernodal import _ereach, factor_numeric, solve_numeric, supernodes
+from rotomorph.solve.supernodal import ereach, factor_numeric, solve_numeric, supernodes
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,7 +70,7 @@ def _column_counts(n, bp, bi, parent):  # pragma: no cover - compiled
     s = np.empty(n, dtype=np.int64)
     w = -np.ones(n, dtype=np.int64)
     for k in range(n):
-        top = _ereach(k, bp, bi, parent, s, w)
+        top = ereach(k, bp, bi, parent, s, w)
         for t in range(top, n):
             counts[s[t]] += 1
     return counts

@@ -22,7 +22,8 @@ Two certificates, cheapest first:
    ``eigsh``, if they have not within its basis) with the shift below the lowest eigenvalue,
    found by trial factorizations (Ericsson & Ruhe, *Math. Comp.* 35, 1980; a trial that a
    rigid direction's negative Rayleigh quotient already rules out is skipped), and the rigid
-   span projected out of every solve.
+   span projected out of every solve. An unstable point's eigenpairs come from ARPACK in every
+   case: the solver leaves the saddle along its mode.
 
 ``stable`` is True when the Cholesky certificate succeeds or the lowest eigenvalue is above
 ``-tol * scale`` (``scale`` the largest diagonal ratio ``H_ii / M_ii``): an eigenvalue within
@@ -312,12 +313,11 @@ def _sparse_eigen(
             vec = vec[:, ::-1]
             norms = np.sqrt(np.einsum("ij,i,ij->j", vec, M, vec))
             return lam, vec / norms, extra
-        # unstable: its modes steer the solver off the saddle (and the lift probe's start),
-        # so they come from ARPACK run to its own tolerance, as the eigenvalues' verdict does
-        # not need: a Ritz vector stopped at the eigenvalues' convergence is less accurate,
-        # and an escape along a different vector can reach another equilibrium
+        # unstable: the solver leaves the saddle along these modes (the lift probe starts
+        # along them), and a Ritz vector stopped when the eigenvalues converged is less
+        # accurate than ARPACK's; an escape along it can reach another equilibrium
     # not converged within the Lanczos basis, or unstable: ARPACK's implicitly restarted
-    # Lanczos
+    # Lanczos, run to its own tolerance
     lin = spla.LinearOperator((n, n), matvec=lambda v: matvec(H, np.ravel(v)), dtype=float)
     opinv = spla.LinearOperator((n, n), matvec=op_inv, dtype=float)
     kwargs = dict(k=want, M=sp.diags(M), sigma=sigma, which="LM", OPinv=opinv, v0=v0, tol=1e-8)

@@ -24,7 +24,7 @@ from numba import njit
 
 
 @njit(cache=True)
-def _ereach(k, bp, bi, parent, s, w):  # pragma: no cover - compiled
+def ereach(k, bp, bi, parent, s, w):  # pragma: no cover - compiled
     """Pattern of row k of L (columns < k) in s[top:], topologically ordered."""
     n = s.shape[0]
     top = n
@@ -80,7 +80,7 @@ def supernodes(n, bp, bi, parent, lp):  # pragma: no cover - compiled
     stack = np.empty(n, dtype=np.int64)
     mark = -np.ones(n, dtype=np.int64)
     for k in range(n):
-        top = _ereach(k, bp, bi, parent, stack, mark)
+        top = ereach(k, bp, bi, parent, stack, mark)
         for t in range(top, n):
             i = stack[t]
             if first[snode[i]] == i:
