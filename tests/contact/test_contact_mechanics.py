@@ -163,6 +163,9 @@ def test_obstacle_constructors_check_units_and_shapes():
         Contact(radius=0.0)
     with pytest.raises(InvalidParameterError, match=r"Contact\.obstacles"):
         Contact(radius=0.3, obstacles=("floor",))  # type: ignore[arg-type]
+    for bad in (0.0, -1.0, np.inf, np.nan):
+        with pytest.raises(InvalidParameterError, match=r"Contact\.stiffness_scale"):
+            Contact(radius=0.3, stiffness_scale=bad)
     cyl = Cylinder.along((0, 0, 1), (1, 0, 0), radius=1.75, length=20.0)
     assert cyl.start == (-10.0, 0.0, 1.0) and cyl.moved((0, 0, 1)).end == (10.0, 0.0, 2.0)
     assert Floor(normal=(0, 0, 2)).normal == (0.0, 0.0, 1.0)
@@ -273,3 +276,12 @@ def test_excluded_pairs_are_remembered_per_network_and_settings():
     assert np.array_equal(a.excluded, fresh) and len(fresh)
     wider = ContactPotential(Contact(R, reach=4.0 * R), net)
     assert wider.excluded is not a.excluded and len(wider.excluded) > len(a.excluded)
+
+
+def test_stiffness_scale_multiplies_the_default_stiffness_only():
+    net = Network(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1], [1, 2]]))
+    base = ContactPotential(Contact(radius=0.1), net, force_scale=2.0).kappa
+    soft = ContactPotential(Contact(radius=0.1, stiffness_scale=0.01), net, force_scale=2.0)
+    assert soft.kappa == pytest.approx(0.01 * base, rel=1e-15)
+    given = Contact(radius=0.1, stiffness=3.0, stiffness_scale=0.01)
+    assert ContactPotential(given, net).kappa == 3.0

@@ -79,6 +79,9 @@ class Contact:
     stiffness
         Barrier stiffness κ (N/mm⁵); default: chosen by the solver from the problem's force
         scale so that a pair at half the activation distance carries a typical nodal force.
+    stiffness_scale
+        Multiplier of that default stiffness (dimensionless, > 0; default 1); ignored when
+        ``stiffness`` is given.
     reach
         Graph distance (mm) below which segments count as neighbours and never touch; default
         ``π max(r_a + r_b) / 2`` (:mod:`rotomorph.contact.exclusion`).
@@ -94,6 +97,7 @@ class Contact:
     self_contact: bool = True
     activation_distance: float | None = None
     stiffness: float | None = None
+    stiffness_scale: float = 1.0
     reach: float | None = None
     friction: float = 0.0
     slip: float | None = None
@@ -115,6 +119,11 @@ class Contact:
             v = getattr(self, name)
             if v is not None and not (np.isfinite(v) and v > 0):
                 raise InvalidParameterError(f"Contact.{name}", f"must be > 0 or None; got {v}")
+        if not (np.isfinite(self.stiffness_scale) and self.stiffness_scale > 0):
+            raise InvalidParameterError(
+                "Contact.stiffness_scale",
+                f"must be > 0 (1: the default stiffness); got {self.stiffness_scale}",
+            )
         if not (np.isfinite(self.friction) and self.friction >= 0):
             raise InvalidParameterError(
                 "Contact.friction", f"must be >= 0 (0: frictionless); got {self.friction}"
@@ -287,7 +296,7 @@ class ContactPotential:
             # |b'(zhat/2)| = (1/2 + ln 2) zhat  (barrier module)
             w = float(np.median(length))
             zhat = (2.0 * dmin_small + self.dhat) * self.dhat
-            self.kappa = float(
+            self.kappa = contact.stiffness_scale * float(
                 ACTIVATION_FORCE * force_scale / (w * (0.5 + np.log(2.0)) * zhat * 2 * dmin_small)
             )
         self._max_length = float(length.max())

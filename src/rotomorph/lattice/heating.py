@@ -55,6 +55,7 @@ from rotomorph.lattice.paths import (
     shape_distance,
     sub_stepped,
 )
+from rotomorph.lattice.resting import resting_rotation
 from rotomorph.rod.assembly import reference_twist
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
@@ -738,6 +739,15 @@ def _gaps_per_step(probes: dict[float, float], values: FloatArray) -> FloatArray
 #: state, 0.3 l and 0.5 l in another one (A/A0 0.2796 against 0.2778).
 LIFT_PROBE_HEIGHT = 0.1
 
+#: Barrier stiffness of the weightless buckling solve of :func:`_lift_probe`, as a fraction
+#: of the ramp's: that solve only finds a start for the solves on the floor (which use the
+#: ramp's contact model), and in a weightless crumpling the contact forces are far below the
+#: force scale the default stiffness is sized by, so a full-stiffness barrier holds the pairs
+#: at the edge of the activation distance, where it has almost no curvature: Newton steps run
+#: into them and are cut to a few per cent (measured on the paper's contracting 5 x 5 ramp:
+#: 146 iterations; 62 at this softening, and the same lifted state).
+SEARCH_SOFTENING = 0.01
+
 
 def _lift_probe(
     model: Model,
@@ -765,8 +775,12 @@ def _lift_probe(
     within a filament diameter of its printed height) and the unsupported lattice's lowest
     mode is unstable: it solves from the resting state lifted along that mode (highest point
     :data:`LIFT_PROBE_HEIGHT` · l): first weightless and away from the floor, where the
-    lattice buckles freely; then laid on the floor either way up (one buckled shape, two
-    orientations), where it settles under its weight. It returns ``(best lifted result or
+    lattice buckles freely (with a softer barrier, :data:`SEARCH_SOFTENING`: this solve only
+    finds a shape); then laid on the floor either way up (one buckled shape, two
+    orientations), toppled as a rigid body into the pose it rests in under its weight
+    (:func:`~rotomorph.lattice.resting.resting_rotation`; a saddle laid on its two low corners
+    rocks over), where its elastic equilibrium under its weight is solved with the ramp's
+    contact model. It returns ``(best lifted result or
     None, its energy minus the resting one or None, Newton iterations spent)``. A lifted
     result is returned only if it is certified stable, lower in total energy (elastic +
     weight + barrier) and actually off the floor. A lift found inside a halved or path-check
@@ -783,7 +797,12 @@ def _lift_probe(
         return None, None, 0
     spent = 0
     # 1. the weightless lattice away from the floor buckles from the flat state along the mode
-    afloat = replace(settings, obstacles=tuple(o for o in settings.obstacles if o is not floor))
+    afloat = replace(
+        settings,
+        obstacles=tuple(o for o in settings.obstacles if o is not floor),
+        stiffness=None if settings.stiffness is None else SEARCH_SOFTENING * settings.stiffness,
+        stiffness_scale=SEARCH_SOFTENING * settings.stiffness_scale,
+    )
     dz = v * (LIFT_PROBE_HEIGHT * lattice.spacing / float(np.abs(v).max()))
     try:
         free = solve_static(
@@ -803,7 +822,7 @@ def _lift_probe(
     best: StaticResult | None = None
     gap_floor = float(floor.height_of(resting.positions).min())
     for flip in (False, True):
-        start = _laid_on(free.state, floor, gap_floor, flip)
+        start = _laid_on(free.state, floor, gap_floor, flip, lattice.network.edges)
         try:
             trial = solve_static(
                 model, supports, loads, initial=start, options=options, contact=settings
@@ -918,9 +937,12 @@ def _rise(floor: Floor, lattice: Lattice, positions: FloatArray) -> float:
     return float((floor.height_of(positions) - floor.height_of(lattice.network.nodes)).max())
 
 
-def _laid_on(state: State, floor: Floor, height: float, flip: bool) -> State:
-    """``state`` moved rigidly (turned upside down about the lattice's x axis when ``flip``)
-    so that its lowest node is ``height`` (mm) above ``floor``."""
+def _laid_on(state: State, floor: Floor, height: float, flip: bool, edges: IntArray) -> State:
+    """``state`` moved rigidly (turned upside down about the lattice's x axis when ``flip``),
+    toppled as a rigid body into the pose where it rests on ``floor`` under its weight (uniform
+    per unit length of the network's ``edges``; :func:`resting_rotation`) with its centre of
+    mass over the same point of the floor, and lowered so that its lowest node is ``height``
+    (mm) above ``floor``."""
     n = np.asarray(floor.normal, dtype=float)
     rot = np.eye(3)
     if flip:  # a half turn about an axis in the floor's plane
@@ -928,6 +950,14 @@ def _laid_on(state: State, floor: Floor, height: float, flip: bool) -> State:
         rot = 2.0 * np.outer(a, a) - np.eye(3)
     centre = state.positions.mean(axis=0)
     pos = (state.positions - centre) @ rot.T + centre
+    half = 0.5 * np.linalg.norm(pos[edges[:, 1]] - pos[edges[:, 0]], axis=1)
+    weight = np.asarray(np.bincount(edges.ravel(), np.repeat(half, 2), len(pos)), dtype=float)
+    turn, shift = resting_rotation(pos, weight, n)
+    before = weight @ pos / weight.sum()
+    pos = pos @ turn.T + shift
+    rot = turn @ rot
+    moved = weight @ pos / weight.sum() - before
+    pos -= moved - (moved @ n) * n  # back over the same point of the floor
     pos += (height - float(floor.height_of(pos).min())) * n
     return replace(
         state, positions=pos, tangents=state.tangents @ rot.T, directors=state.directors @ rot.T
