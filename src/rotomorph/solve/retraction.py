@@ -100,10 +100,15 @@ class EdgeRotationRetraction:
             ),
             shape=(e, n_nodes),
         )
-        self._Bd = B[:, self.fixed].tocsc()
+        Bd = B[:, self.fixed].tocsc()
         Bf = B[:, self.free].tocsc()
-        self._BfT = Bf.T.tocsr()
-        self._lu = spla.splu((self._BfT @ Bf).tocsc()) if len(self.free) else None
+        BfT = Bf.T.tocsr()
+        self._lu = spla.splu((BfT @ Bf).tocsc()) if len(self.free) else None
+        # the sparse products of the right-hand side, compiled (see _least_squares_rhs)
+        self._Bd = (Bd.indptr.astype(np.int64), Bd.indices.astype(np.int64), Bd.data)
+        self._BfT = (BfT.indptr.astype(np.int64), BfT.indices.astype(np.int64), BfT.data)
+        self._residual = np.empty((e, 3))
+        self._rhs = np.empty((len(self.free), 3))
 
     def __call__(self, x: FloatArray, dx: FloatArray, alpha: float) -> FloatArray:
         """Node positions ``(N, 3)`` reached from ``x`` along ``alpha dx`` (both ``(N, 3)``)."""
@@ -125,12 +130,79 @@ class EdgeRotationRetraction:
                 out,
             )
             return out
-        xd = x[self.fixed] + (alpha * dx[self.fixed] if self.anchor_first else 0.0)
-        out[self.fixed] = xd
+        _least_squares_rhs(
+            x,
+            dx,
+            alpha,
+            self.anchor_first,
+            self.fixed,
+            *self._Bd,
+            *self._BfT,
+            self._target,
+            self._residual,
+            out,
+            self._rhs,
+        )
         if self._lu is not None:
-            rhs = self._BfT @ (self._target - self._Bd @ xd)
-            out[self.free] = self._lu.solve(np.ascontiguousarray(rhs))
+            _set_rows(out, self.free, self._lu.solve(self._rhs))
         return out
+
+
+@njit(cache=True)
+def _least_squares_rhs(
+    x,
+    dx,
+    alpha,
+    move_fixed,
+    fixed,
+    bd_ptr,
+    bd_idx,
+    bd_val,
+    bt_ptr,
+    bt_idx,
+    bt_val,
+    target,
+    residual,
+    out,
+    rhs,
+):  # pragma: no cover - compiled
+    """Fixed nodes of ``out`` and the right-hand side ``Bf^T (target - Bd xd)`` of the least
+    squares, ``Bd`` (CSC) and ``Bf^T`` (CSR) given by their arrays.
+
+    The products accumulate in SciPy's order (``csc_matvecs``, ``csr_matvecs``), so the nodes
+    are the same to the last bit as with its sparse matrices, without their per-call overhead.
+    """
+    for i in range(fixed.shape[0]):
+        n = fixed[i]
+        for k in range(3):
+            out[n, k] = x[n, k] + (alpha * dx[n, k] if move_fixed else 0.0)
+    for r in range(residual.shape[0]):
+        for k in range(3):
+            residual[r, k] = 0.0
+    for c in range(fixed.shape[0]):
+        n = fixed[c]
+        for p in range(bd_ptr[c], bd_ptr[c + 1]):
+            r = bd_idx[p]
+            for k in range(3):
+                residual[r, k] += bd_val[p] * out[n, k]
+    for r in range(residual.shape[0]):
+        for k in range(3):
+            residual[r, k] = target[r, k] - residual[r, k]
+    for i in range(rhs.shape[0]):
+        for k in range(3):
+            rhs[i, k] = 0.0
+        for p in range(bt_ptr[i], bt_ptr[i + 1]):
+            r = bt_idx[p]
+            for k in range(3):
+                rhs[i, k] += bt_val[p] * residual[r, k]
+
+
+@njit(cache=True)
+def _set_rows(out, rows, values):  # pragma: no cover - compiled
+    """``out[rows] = values`` for ``(N, 3)`` arrays."""
+    for i in range(rows.shape[0]):
+        for k in range(3):
+            out[rows[i], k] = values[i, k]
 
 
 def _bfs_tree(edges: IntArray, n: int, root: int):  # type: ignore[no-untyped-def]
