@@ -162,3 +162,29 @@ def test_gauss_newton_hessian_is_positive_semidefinite(rng):
     assert np.linalg.eigvalsh(Hgn).min() >= -1e-10 * np.abs(Hgn).max()
     H = _dense(obj.evaluate(q, True, True)[2])
     assert np.linalg.eigvalsh(H).min() < 0  # the displaced state is not convex: GN differs
+
+
+@pytest.mark.parametrize("which", [0, 1], ids=["chain", "junctions"])
+def test_energy_only_evaluation_is_the_full_one_to_the_bit(rng, which):
+    """A line-search trial (no gradient, no Hessian) takes the energy-only kernel: same energy,
+    same transported frames and reference twists (which ``accept`` re-bases on) as the full
+    evaluation, to the last bit, on random states far from the base and with twist turned past
+    the unwrapping range."""
+    net = _networks(rng)[which]
+    model = anisotropic_model(net, rng)
+    obj, q = displaced_objective(model, rng)
+    for scale in (1e-3, 0.1, 0.5):
+        for twist in (0.1, 4.0):
+            dq = rng.normal(0.0, scale, len(q))
+            dq[np.isin(obj.free, model.layout.theta)] *= twist / scale
+            trial = q + dq
+            frames = []
+            energies = []
+            for need_grad, need_hess in ((False, 0), (True, 0), (True, 1), (True, 2)):
+                energies.append(obj.evaluate(trial, need_grad, need_hess)[0])
+                frames.append([a.copy() for a in (obj._t, obj._d1, obj._m1, obj._m2, obj._mref)])
+            assert np.isfinite(energies[0])
+            assert all(e == energies[0] for e in energies[1:]), energies
+            for other in frames[1:]:
+                for a, b in zip(frames[0], other, strict=True):
+                    np.testing.assert_array_equal(a, b)

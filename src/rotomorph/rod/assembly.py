@@ -15,7 +15,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from rotomorph.rod.kernels import _cross, _dot, _row, bend_twist_stencil, stretch_edge
+from rotomorph.rod.kernels import (
+    _cross,
+    _dot,
+    _row,
+    bend_measures,
+    bend_twist_energy,
+    bend_twist_stencil,
+    stretch_edge,
+    stretch_energy,
+)
 
 _CACHE = True
 
@@ -290,8 +299,28 @@ def evaluate_network(
     Packed parameters: ``st_edges`` (S, 2) = (edge_e, edge_f); ``st_signs`` (S, 2);
     ``st_params`` (S, 7) = (B1, B2, C, voronoi, kappa1_bar, kappa2_bar, tau_bar) integrated;
     ``ed_params`` (E, 2) = (EA, rest length). One compiled call per evaluation keeps the
-    per-call overhead of many array arguments out of the Newton loop.
+    per-call overhead of many array arguments out of the Newton loop. Without gradient and
+    Hessian (a line-search trial) the energy comes from :func:`network_energy`.
     """
+    if not (need_grad or need_hess):
+        return network_energy(
+            pos,
+            theta,
+            t_base,
+            d1_base,
+            mref_base,
+            t,
+            d1,
+            m1,
+            m2,
+            mref,
+            edges,
+            st_nodes,
+            st_edges,
+            st_signs,
+            st_params,
+            ed_params,
+        )
     transport_frames(pos, edges, t_base, d1_base, t, d1)
     reference_twist(st_edges, st_signs, t, d1, mref_base, mref)
     material_frames(t, d1, theta, m1, m2)
@@ -325,3 +354,72 @@ def evaluate_network(
         st_hess,
         ed_hess,
     )
+
+
+@njit(cache=_CACHE)
+def network_energy(
+    pos,
+    theta,
+    t_base,
+    d1_base,
+    mref_base,
+    t,
+    d1,
+    m1,
+    m2,
+    mref,
+    edges,
+    st_nodes,
+    st_edges,
+    st_signs,
+    st_params,
+    ed_params,
+):
+    """The energy of :func:`evaluate_network` alone (N mm), with the same frames ``t, d1, m1,
+    m2`` and reference twists ``mref``: no derivative work, no per-stencil work buffers.
+
+    Every quantity comes from the same expressions, and the energies are summed in the same
+    order (stencils, then edges), as in :func:`assemble`: the two agree to the last bit.
+    """
+    transport_frames(pos, edges, t_base, d1_base, t, d1)
+    reference_twist(st_edges, st_signs, t, d1, mref_base, mref)
+    material_frames(t, d1, theta, m1, m2)
+    energy = 0.0
+    for s in range(st_nodes.shape[0]):
+        ea = st_edges[s, 0]
+        fb = st_edges[s, 1]
+        se = st_signs[s, 0]
+        sf = st_signs[s, 1]
+        m2e = (se * m2[ea, 0], se * m2[ea, 1], se * m2[ea, 2])
+        m2f = (sf * m2[fb, 0], sf * m2[fb, 1], sf * m2[fb, 2])
+        kappa1, kappa2 = bend_measures(
+            _row(pos, st_nodes[s, 0]),
+            _row(pos, st_nodes[s, 1]),
+            _row(pos, st_nodes[s, 2]),
+            _row(m1, ea),
+            m2e,
+            _row(m1, fb),
+            m2f,
+        )[6:]
+        tw = sf * theta[fb] - se * theta[ea] + mref[s]
+        energy += bend_twist_energy(
+            kappa1,
+            kappa2,
+            tw,
+            st_params[s, 0],
+            st_params[s, 1],
+            st_params[s, 2],
+            st_params[s, 3],
+            st_params[s, 4],
+            st_params[s, 5],
+            st_params[s, 6],
+        )[0]
+    for j in range(edges.shape[0]):
+        a = edges[j, 0]
+        b = edges[j, 1]
+        e0 = pos[b, 0] - pos[a, 0]
+        e1 = pos[b, 1] - pos[a, 1]
+        e2 = pos[b, 2] - pos[a, 2]
+        length = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        energy += stretch_energy(length, ed_params[j, 0], ed_params[j, 1])[0]
+    return energy

@@ -133,6 +133,36 @@ def _place_theta(H, w, col, De, Df):
         H[col, 8 + i] += w * c
 
 
+@njit(cache=_CACHE, inline="always")
+def bend_measures(x0, x1, x2, m1e, m2e, m1f, m2f):
+    """Edge lengths ``ne, nf`` (mm), unit tangents ``te, tf``, ``chi``, curvature binormal
+    ``kb`` and integrated curvatures ``kappa1, kappa2`` of one stencil (arguments as for
+    :func:`bend_twist_stencil`)."""
+    e = (x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2])
+    f = (x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2])
+    ne = np.sqrt(_dot(e, e))
+    nf = np.sqrt(_dot(f, f))
+    te = _lin(1.0 / ne, e, 0.0, e)
+    tf = _lin(1.0 / nf, f, 0.0, f)
+    chi = 1.0 + _dot(te, tf)
+    kb = _lin(2.0 / chi, _cross(te, tf), 0.0, e)
+    kappa1 = 0.5 * (_dot(kb, m2e) + _dot(kb, m2f))
+    kappa2 = -0.5 * (_dot(kb, m1e) + _dot(kb, m1f))
+    return ne, nf, te, tf, chi, kb, kappa1, kappa2
+
+
+@njit(cache=_CACHE, inline="always")
+def bend_twist_energy(kappa1, kappa2, twist, B1, B2, C, voronoi, k1bar, k2bar, taubar):
+    """Energy of one stencil (N mm) from its curvatures and twist, with the strains
+    ``kappa1 - k1bar``, ``kappa2 - k2bar``, ``twist - taubar`` and ``1 / voronoi``."""
+    dk1 = kappa1 - k1bar
+    dk2 = kappa2 - k2bar
+    dtw = twist - taubar
+    inv_l = 1.0 / voronoi
+    energy = 0.5 * inv_l * (B1 * dk1 * dk1 + B2 * dk2 * dk2 + C * dtw * dtw)
+    return energy, dk1, dk2, dtw, inv_l
+
+
 @njit(cache=_CACHE)
 def bend_twist_stencil(
     x0,
@@ -167,21 +197,10 @@ def bend_twist_stencil(
     ``sum_k w_k grad(k) grad(k)^T`` (positive semidefinite, used where the exact Hessian is
     indefinite). Returns ``(energy, kappa1, kappa2)``.
     """
-    e = (x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2])
-    f = (x2[0] - x1[0], x2[1] - x1[1], x2[2] - x1[2])
-    ne = np.sqrt(_dot(e, e))
-    nf = np.sqrt(_dot(f, f))
-    te = _lin(1.0 / ne, e, 0.0, e)
-    tf = _lin(1.0 / nf, f, 0.0, f)
-    chi = 1.0 + _dot(te, tf)
-    kb = _lin(2.0 / chi, _cross(te, tf), 0.0, e)
-    kappa1 = 0.5 * (_dot(kb, m2e) + _dot(kb, m2f))
-    kappa2 = -0.5 * (_dot(kb, m1e) + _dot(kb, m1f))
-    dk1 = kappa1 - k1bar
-    dk2 = kappa2 - k2bar
-    dtw = twist - taubar
-    inv_l = 1.0 / voronoi
-    energy = 0.5 * inv_l * (B1 * dk1 * dk1 + B2 * dk2 * dk2 + C * dtw * dtw)
+    ne, nf, te, tf, chi, kb, kappa1, kappa2 = bend_measures(x0, x1, x2, m1e, m2e, m1f, m2f)
+    energy, dk1, dk2, dtw, inv_l = bend_twist_energy(
+        kappa1, kappa2, twist, B1, B2, C, voronoi, k1bar, k2bar, taubar
+    )
     if not (need_grad or need_hess):
         return energy, kappa1, kappa2
 
@@ -335,6 +354,14 @@ def bend_twist_stencil(
     return energy, kappa1, kappa2
 
 
+@njit(cache=_CACHE, inline="always")
+def stretch_energy(length, axial_stiffness, rest_length):
+    """Stretching energy of an edge of ``length`` (mm), with ``EA / l`` and ``|e| - l``."""
+    k = axial_stiffness / rest_length
+    dl = length - rest_length
+    return 0.5 * k * dl * dl, k, dl
+
+
 @njit(cache=_CACHE)
 def stretch_edge(xi, xj, axial_stiffness, rest_length, grad, hess, need_grad, need_hess):
     r"""Stretching energy :math:`\tfrac12 (EA/\bar l)(|e|-\bar l)^2` of one edge (N mm).
@@ -346,9 +373,7 @@ def stretch_edge(xi, xj, axial_stiffness, rest_length, grad, hess, need_grad, ne
     e1 = xj[1] - xi[1]
     e2 = xj[2] - xi[2]
     n = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    k = axial_stiffness / rest_length
-    dl = n - rest_length
-    energy = 0.5 * k * dl * dl
+    energy, k, dl = stretch_energy(n, axial_stiffness, rest_length)
     if need_grad or need_hess:
         t0 = e0 / n
         t1 = e1 / n
