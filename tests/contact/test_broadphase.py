@@ -158,3 +158,70 @@ def test_step_bounds_from_one_start_share_its_distances(rng):
     known = ~np.isnan(shared)
     assert known.sum() > 20 and len(set(bounds)) > 4 and min(bounds) < 1.0
     assert np.array_equal(shared[known], pair_distances(x, quads)[known])
+
+
+def _all_pairs(x0, x1, edges, incident, seg_share, node_share, excluded):
+    """Every segment pair and node–segment pair whose boxes over ``x0 -> x1`` come closer than
+    the sum of their shares and that may touch, by brute force over all pairs (sets)."""
+    ne = len(edges)
+    seg_pts = np.concatenate([x0[edges], x1[edges]], axis=1)  # (E, 4, 3)
+    lo = np.concatenate([seg_pts.min(axis=1), np.minimum(x0, x1)])
+    hi = np.concatenate([seg_pts.max(axis=1), np.maximum(x0, x1)])
+    share = np.concatenate([seg_share, node_share])
+    gap = np.maximum(np.maximum(lo[None] - hi[:, None], lo[:, None] - hi[None]), 0.0)
+    reach = share[:, None] + share[None]
+    near = ((gap**2).sum(axis=2) < reach**2) & (gap < reach[..., None]).all(axis=2)
+    blocked = set(excluded.tolist())
+
+    def touch(a: int, b: int) -> bool:
+        return a != b and min(a, b) * ne + max(a, b) not in blocked
+
+    seg = {(a, b) for a in range(ne) for b in range(a + 1, ne) if near[a, b] and touch(a, b)}
+    node = {
+        (n, e)
+        for n in range(len(x0))
+        for e in range(ne)
+        if near[ne + n, e] and all(touch(f, e) for f in incident[n] if f >= 0)
+    }
+    return seg, node
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_near_pairs_equal_brute_force(seed):
+    """The compiled broad phase proposes exactly the pairs of an all-pairs test (each pair
+    once), at a configuration and along a step, on a crumpled lattice-like sheet of filaments
+    lifted out of its plane (many boxes in one sweep window, many exclusions)."""
+    from rotomorph.contact.broadphase import near_pairs
+    from rotomorph.contact.exclusion import excluded_pairs
+
+    rng = np.random.default_rng(seed)
+    rows, cols = 6, 9
+    u, v = np.meshgrid(np.linspace(0.0, 8.0, cols), np.linspace(0.0, 5.0, rows))
+    idx = np.arange(rows * cols).reshape(rows, cols)
+    edges = np.vstack(
+        [
+            np.stack([idx[:, :-1].ravel(), idx[:, 1:].ravel()], axis=1),
+            np.stack([idx[:-1].ravel(), idx[1:].ravel()], axis=1),
+        ]
+    )
+    flat = np.stack([u.ravel(), v.ravel(), np.zeros(u.size)], axis=1)
+    lift = rng.uniform(1.0, 4.0) * np.sin(u / rng.uniform(1.5, 3.0)) * np.cos(v / 2.0)
+    x0 = flat + np.stack([0 * u, 0 * u, lift], axis=-1).reshape(-1, 3)
+    x0 = x0 + rng.normal(scale=0.15, size=x0.shape)
+    radius = np.full(len(edges), 0.2)
+    excluded = excluded_pairs(flat, edges, radius, 0.02, None)
+    deg = np.bincount(edges.ravel(), minlength=len(x0))
+    incident = -np.ones((len(x0), deg.max()), dtype=np.int64)
+    fill = np.zeros(len(x0), dtype=np.int64)
+    for k, (a, b) in enumerate(edges):
+        incident[a, fill[a]], incident[b, fill[b]] = k, k
+        fill[a] += 1
+        fill[b] += 1
+    share = rng.uniform(0.3, 0.9, len(edges))
+    node_share = rng.uniform(0.3, 0.9, len(x0))
+    for x1 in (x0, x0 + rng.normal(scale=0.5, size=x0.shape)):
+        seg, node = near_pairs(x0, x1, edges, incident, share, node_share, excluded)
+        want_seg, want_node = _all_pairs(x0, x1, edges, incident, share, node_share, excluded)
+        assert len(want_seg) > 30 and len(want_node) > 30
+        assert _sets(seg) == want_seg and len(seg) == len(want_seg)
+        assert _sets(node) == want_node and len(node) == len(want_node)
