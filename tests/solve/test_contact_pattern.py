@@ -106,3 +106,56 @@ def test_an_entry_outside_the_pattern_grows_it_even_when_the_pair_is_remembered(
     assert again is not None
     assert np.array_equal(again.csc.toarray(), _reference(base, blocks, coord, pattern._union))
     assert again.csc[0, 18] == blocks.pair[0, 0, 6]
+
+
+def test_a_grown_pattern_equals_one_built_afresh_from_its_keys():
+    """Growing the union by inserting keys (and moving the stored positions) gives the arrays,
+    base positions and symbolic analysis that a fresh build from all the keys gives; the base
+    pattern changing midway (a coupling the contact blocks do not have) included."""
+    from rotomorph.solve.sparse_cholesky import analyse
+
+    rng = np.random.default_rng(5)
+    n_nodes = 25
+    coord = np.arange(3 * n_nodes, dtype=np.int64)
+    n = 3 * n_nodes
+    tri = sp.diags(np.arange(1.0, n + 1)) + sp.eye(n, k=1) + sp.eye(n, k=-1)
+    wider = sp.csc_matrix(tri + 0.5 * (sp.eye(n, k=7) + sp.eye(n, k=-7)))
+    pattern = HessianPattern()
+    pool = _quads(rng, n_nodes, 30)
+    keys = []
+    for call in range(20):
+        base = sp.csc_matrix(tri) if call < 10 else wider
+        blocks = _blocks(rng, n_nodes, pool[rng.choice(10 + call, size=6, replace=False)])
+        total = pattern.add(base, blocks, coord)
+        assert total is not None
+        found = np.zeros(144 * len(blocks.quads) + 9 * len(blocks.nodes), dtype=np.int64)
+        count = _scatter_blocks(
+            np.zeros(n + 1, dtype=np.int32), np.zeros(0, dtype=np.int32), coord, n_nodes,
+            blocks.quads, blocks.pair, blocks.nodes, blocks.node, np.zeros(0), found,
+        )  # fmt: skip
+        coo = base.tocoo()
+        keys += [found[:count], coo.col.astype(np.int64) * n + coo.row]
+        union = np.unique(np.concatenate(keys))
+        assert np.array_equal(pattern._keys, union)
+        rows, indptr = pattern._union
+        assert np.array_equal(rows, union % n)
+        assert np.array_equal(indptr, np.searchsorted(union // n, np.arange(n + 1)))
+        bkeys = np.repeat(np.arange(n), np.diff(base.indptr)) * n + base.indices
+        assert np.array_equal(pattern._base_pos, np.searchsorted(union, bkeys))
+        fresh = analyse(sp.csc_matrix((np.ones(len(rows)), rows, indptr), shape=(n, n)),
+                        pattern._sym.perm)  # fmt: skip
+        for name in ("bp", "bi", "src", "diag_src", "parent", "lp"):
+            assert np.array_equal(getattr(pattern._sym, name), getattr(fresh, name)), name
+        assert np.array_equal(total.csc.toarray(), _reference(base, blocks, coord, pattern._union))
+    assert pattern.analyses > 5 and int(pattern._used[0]) > 10
+
+
+def test_an_absent_entry_is_not_found_in_the_next_column():
+    """Looking up an entry that is not in its column, whose row is the first row of the next
+    column, says 'absent' (a position there would add the value to the wrong entry)."""
+    from rotomorph.solve.contact_term import _find
+
+    indices = np.array([0, 2, 1, 2], dtype=np.int32)  # column 0: rows 0, 2; column 1: 1, 2
+    assert _find(indices, 0, 2, 1, -2) == -1
+    assert _find(indices, 0, 2, 2, -2) == 1
+    assert _find(indices, 2, 4, 1, -2) == 2

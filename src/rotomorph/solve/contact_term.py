@@ -24,7 +24,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.potential import Contact, ContactPotential, HessianBlocks
 from rotomorph.design.network import Network
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
-from rotomorph.solve.sparse_cholesky import Symbolic, analyse
+from rotomorph.solve.sparse_cholesky import Symbolic, analyse_pattern
 
 __all__ = ["ContactTerm", "HessianPattern", "banded_to_csc"]
 
@@ -70,8 +70,10 @@ class HessianPattern:
         # the pattern)
         self._slot_of = Dict.empty(key_type=_QUAD, value_type=types.int64)
         self._slots: IntArray = np.empty((0, 144), dtype=np.int64)
+        self._slot_quads: IntArray = np.empty((0, 4), dtype=np.int64)  # the pair of each row
         self._used = np.zeros(1, dtype=np.int64)
         self._slot_coords: IntArray | None = None  # the coord_reduced they hold for
+        self._slot_nodes = -1  # and the number of network nodes (quads beyond: obstacles)
 
     def add(
         self, base: sp.csc_matrix, contact: HessianBlocks, coord_reduced: IntArray
@@ -87,7 +89,7 @@ class HessianPattern:
             if not base.has_sorted_indices:
                 base = base.sorted_indices()
             if not self._known_base(base):
-                self._grow(base, np.zeros(0, dtype=np.int64), n)
+                self._grow(base, np.zeros(0, dtype=np.int64), n, base_known=False)
         assert self._union is not None
         blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
         cdata = np.zeros(len(self._keys))
@@ -95,7 +97,7 @@ class HessianPattern:
         if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
             keys = np.empty(144 * len(contact.quads) + 9 * len(contact.nodes), dtype=np.int64)
             found = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, keys)
-            self._grow(base, np.unique(keys[:found]), n)
+            self._grow(base, np.unique(keys[:found]), n, base_known=True)
             cdata = np.zeros(len(self._keys))
             count = self._scatter(coord_reduced, contact, cdata)
         if count == 0:
@@ -122,17 +124,26 @@ class HessianPattern:
         the same additions in the same order."""
         assert self._union is not None
         indices, indptr = self._union
-        if self._slot_coords is None or not np.array_equal(self._slot_coords, coord_reduced):
+        if (
+            self._slot_coords is None
+            or self._slot_nodes != contact.n_nodes
+            or not np.array_equal(self._slot_coords, coord_reduced)
+        ):
             self._forget_positions()
             self._slot_coords = coord_reduced.copy()
+            self._slot_nodes = contact.n_nodes
         need = int(self._used[0]) + len(contact.quads)
         if need > len(self._slots):
-            grown = np.empty((max(need, 2 * len(self._slots), 64), 144), dtype=np.int64)
+            rows = max(need, 2 * len(self._slots), 64)
+            grown = np.empty((rows, 144), dtype=np.int64)
             grown[: len(self._slots)] = self._slots
             self._slots = grown
+            grown_quads = np.empty((rows, 4), dtype=np.int64)
+            grown_quads[: len(self._slot_quads)] = self._slot_quads
+            self._slot_quads = grown_quads
         count = _scatter_pairs(
             indptr, indices, coord_reduced, contact.n_nodes, contact.quads, contact.pair, out,
-            self._slot_of, self._slots, self._used,
+            self._slot_of, self._slots, self._slot_quads, self._used,
         )  # fmt: skip
         if count < 0 or not len(contact.nodes):
             return count
@@ -142,31 +153,54 @@ class HessianPattern:
         )  # fmt: skip
         return -1 if floor < 0 else count + floor
 
-    def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int) -> None:
-        bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
-        bkeys = bcol * n + base.indices
+    def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int, base_known: bool) -> None:
+        """Add the keys ``column * n + row`` of ``base`` (unless ``base_known``: its pattern is
+        the one the union holds) and the sorted distinct ``ckeys`` to the union, then
+        re-analyse it. The new keys are inserted into the sorted arrays, and every stored
+        position (the base's, the remembered pair blocks') moves by the number of keys
+        inserted before it: the same arrays as merging and sorting afresh."""
         keys = self._keys
-        for add in (bkeys, ckeys):
-            pos = np.minimum(np.searchsorted(keys, add), max(len(keys) - 1, 0))
-            new = add if not len(keys) else add[keys[pos] != add]
-            if len(new):  # two sorted runs: a stable sort merges them in linear time
-                keys = np.sort(np.concatenate([keys, np.unique(new)]), kind="stable")
-        self._base = (base.indptr.copy(), base.indices.copy())
-        self._base_pos = np.searchsorted(keys, bkeys)
-        if self._union is not None and len(keys) == len(self._keys):
+        last = max(len(keys) - 1, 0)
+        sources = [ckeys]
+        if not base_known:
+            bcol = np.repeat(np.arange(n, dtype=np.int64), np.diff(base.indptr))
+            bkeys = bcol * n + base.indices
+            sources.append(bkeys)
+        missing = [
+            add if not len(keys) else add[keys[np.minimum(np.searchsorted(keys, add), last)] != add]
+            for add in sources
+        ]
+        new = np.unique(np.concatenate(missing))
+        ins = np.searchsorted(keys, new)
+        # old position q moves to q + shift[q]
+        shift = np.cumsum(np.bincount(ins, minlength=len(keys) + 1))
+        if not base_known:
+            self._base = (base.indptr.copy(), base.indices.copy())
+            self._base_pos = np.searchsorted(np.insert(keys, ins, new), bkeys)
+        elif len(new):
+            self._base_pos = self._base_pos + shift[self._base_pos]
+        if self._union is not None and not len(new):
             return  # nothing new (the base's stored entries changed, not the union)
-        rows = (keys % n).astype(np.int32)
-        counts = np.bincount(keys // n, minlength=n)
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+        rows_old, indptr_old = self._union or (
+            np.zeros(0, dtype=np.int32),
+            np.zeros(n + 1, dtype=np.int32),
+        )
+        rows = np.insert(rows_old, ins, (new % n).astype(np.int32))
+        indptr = indptr_old + np.searchsorted(new // n, np.arange(n + 1)).astype(np.int32)
         self._union = (rows, indptr)
-        self._keys = keys
-        self._forget_positions()
-        pattern = sp.csc_matrix((np.ones(len(keys)), rows, indptr), shape=(n, n))
+        self._keys = np.insert(keys, ins, new)
+        if self._slot_coords is not None and len(keys):
+            _move_slots(
+                self._slots, self._slot_quads, int(self._used[0]), shift, self._slot_coords,
+                self._slot_nodes, indptr, rows,
+            )  # fmt: skip
+        else:
+            self._forget_positions()
         # keep the ordering while the factor stays within REORDER of its size when ordered;
         # a new minimum-degree ordering costs more than the numeric factorization
-        sym = None if self._sym is None else analyse(pattern, self._sym.perm)
+        sym = None if self._sym is None else analyse_pattern(indptr, rows, self._sym.perm)
         if sym is None or sym.lp[-1] > REORDER * self._ordered_nnz:
-            sym = analyse(pattern)
+            sym = analyse_pattern(indptr, rows)
             self._ordered_nnz = int(sym.lp[-1])
             self.orderings += 1
         self._sym = sym
@@ -301,13 +335,14 @@ def _find(indices, lo, hi, row, hint):  # pragma: no cover - compiled
     tried first (the next coordinate of the same node)."""
     if lo <= hint + 1 < hi and indices[hint + 1] == row:
         return hint + 1
+    end = hi
     while lo < hi:
         mid = (lo + hi) // 2
         if indices[mid] < row:
             lo = mid + 1
         else:
             hi = mid
-    return lo if lo < indices.shape[0] and indices[lo] == row else -1
+    return lo if lo < end and indices[lo] == row else -1  # (not the next column's first row)
 
 
 @njit(cache=True)
@@ -358,13 +393,13 @@ def _scatter_blocks(
 
 @njit(cache=True)
 def _scatter_pairs(
-    indptr, indices, coord_reduced, n_nodes, quads, pair, out, slot_of, slots, used
+    indptr, indices, coord_reduced, n_nodes, quads, pair, out, slot_of, slots, slot_quads, used
 ):  # pragma: no cover - compiled
     """The pair blocks of :func:`_scatter_blocks` (same entries, same order of additions),
     each pair's data positions looked up in ``slots[slot_of[pair]]`` and found (and stored
-    in row ``used[0]``, which is then advanced) on its first appearance; ``slots`` must have
-    a free row per pair. Returns the number of entries added, or -1 when one is not in the
-    pattern."""
+    in row ``used[0]``, which is then advanced, with the pair in ``slot_quads``) on its first
+    appearance; ``slots`` and ``slot_quads`` must have a free row per pair. Returns the
+    number of entries added, or -1 when one is not in the pattern."""
     count = 0
     for p in range(quads.shape[0]):
         key = (quads[p, 0], quads[p, 1], quads[p, 2], quads[p, 3])
@@ -374,22 +409,9 @@ def _scatter_pairs(
             slot = used[0]
             used[0] += 1
             slot_of[key] = slot
-            e = 0
             for a in range(4):
-                na = quads[p, a]
-                for b in range(4):
-                    nb = quads[p, b]
-                    for m in range(3):
-                        c = coord_reduced[3 * nb + m] if nb < n_nodes else -1
-                        pos = -2
-                        for k in range(3):
-                            r = coord_reduced[3 * na + k] if na < n_nodes else -1
-                            if c < 0 or r < 0:
-                                slots[slot, e] = -1
-                            else:
-                                pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
-                                slots[slot, e] = pos if pos >= 0 else -2
-                            e += 1
+                slot_quads[slot, a] = quads[p, a]
+            _find_slots(indptr, indices, coord_reduced, n_nodes, slot_quads, slot, slots, False)
         e = 0
         for a in range(4):
             for b in range(4):
@@ -405,6 +427,54 @@ def _scatter_pairs(
                         out[t] += v
                         count += 1
     return count
+
+
+@njit(cache=True)
+def _find_slots(
+    indptr, indices, coord_reduced, n_nodes, slot_quads, slot, slots, missing_only
+):  # pragma: no cover - compiled
+    """Data positions of the 144 entries of the pair ``slot_quads[slot]`` in the pattern, in
+    the loop order of :func:`_scatter_blocks`, into ``slots[slot]`` (-1: not a free
+    coordinate, -2: not in the pattern); with ``missing_only``, only the entries now -2."""
+    e = 0
+    for a in range(4):
+        na = slot_quads[slot, a]
+        for b in range(4):
+            nb = slot_quads[slot, b]
+            for m in range(3):
+                c = coord_reduced[3 * nb + m] if nb < n_nodes else -1
+                pos = -2
+                for k in range(3):
+                    if missing_only and slots[slot, e] != -2:
+                        e += 1
+                        pos = -2
+                        continue
+                    r = coord_reduced[3 * na + k] if na < n_nodes else -1
+                    if c < 0 or r < 0:
+                        slots[slot, e] = -1
+                    else:
+                        pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                        slots[slot, e] = pos if pos >= 0 else -2
+                    e += 1
+
+
+@njit(cache=True)
+def _move_slots(
+    slots, slot_quads, used, shift, coord_reduced, n_nodes, indptr, indices
+):  # pragma: no cover - compiled
+    """The remembered data positions after keys were inserted into the pattern: a position
+    ``t`` moves to ``t + shift[t]``, and the entries that were not in the pattern are looked
+    up again in the grown one (``indptr``, ``indices``)."""
+    for slot in range(used):
+        missing = False
+        for e in range(144):
+            t = slots[slot, e]
+            if t >= 0:
+                slots[slot, e] = t + shift[t]
+            elif t == -2:
+                missing = True
+        if missing:
+            _find_slots(indptr, indices, coord_reduced, n_nodes, slot_quads, slot, slots, True)
 
 
 @njit(cache=True)

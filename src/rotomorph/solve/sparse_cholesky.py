@@ -123,12 +123,20 @@ def analyse(A: sp.csc_matrix, perm: IntArray | None = None) -> Symbolic:
     """
     A = sp.csc_matrix(A)
     A.sort_indices()
-    n = A.shape[0]
+    return analyse_pattern(A.indptr, A.indices, perm)
+
+
+def analyse_pattern(indptr: IntArray, indices: IntArray, perm: IntArray | None = None) -> Symbolic:
+    """:func:`analyse` of the pattern given by its CSC arrays (row indices ascending in each
+    column), without building a matrix unless a new ordering is needed."""
+    n = len(indptr) - 1
     if perm is None:
-        perm = ordering(A)
+        perm = ordering(sp.csc_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n)))
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
-    bp, bi, src = _permuted_upper(n, A.indptr.astype(np.int64), A.indices.astype(np.int64), inv)
+    bp, bi, src = _permuted_upper(
+        n, np.asarray(indptr, dtype=np.int64), np.asarray(indices, dtype=np.int64), inv
+    )
     bj = np.repeat(np.arange(n), np.diff(bp))
     diag_src = np.full(n, -1, dtype=np.int64)
     is_diag = bi == bj
