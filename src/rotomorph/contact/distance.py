@@ -231,6 +231,25 @@ def pair_distances(x, pairs):  # pragma: no cover - compiled
     return out
 
 
+@njit(cache=True)
+def node_motions(x, x_ref, out):  # pragma: no cover - compiled
+    """Distance (mm) each node of ``x`` (N, 3) has moved from ``x_ref`` into ``out[:N]``, with
+    ``out[N:]`` = 0 (fixed obstacle points of an extended point array); returns the largest
+    (NaN if any is). The same sums as ``np.sqrt(((x - x_ref) ** 2).sum(axis=1))``."""
+    worst = 0.0
+    for i in range(x.shape[0]):
+        d0 = x[i, 0] - x_ref[i, 0]
+        d1 = x[i, 1] - x_ref[i, 1]
+        d2 = x[i, 2] - x_ref[i, 2]
+        m = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        out[i] = m
+        if m > worst or m != m:
+            worst = m if worst == worst else worst
+    for i in range(x.shape[0], out.shape[0]):
+        out[i] = 0.0
+    return worst
+
+
 #: relative margin by which :func:`distance_bound` must clear a threshold before a caller skips
 #: the exact distance on it (far above the bound's round-off)
 BOUND_MARGIN = 1e-9

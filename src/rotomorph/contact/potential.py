@@ -27,7 +27,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.barrier import barrier, pair_barrier, plane_barrier
 from rotomorph.contact.broadphase import near_pairs, near_subset, within_reach
 from rotomorph.contact.ccd import pair_step_bound, plane_step_bound
-from rotomorph.contact.distance import closest_parameters, pair_distances
+from rotomorph.contact.distance import closest_parameters, node_motions, pair_distances
 from rotomorph.contact.exclusion import excluded_pairs
 from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
@@ -54,6 +54,8 @@ SWEPT_SLACK = 0.25
 
 _NO_INT = np.zeros(0, dtype=np.int64)
 _NO_PAIRS = np.zeros((0, 2), dtype=np.int64)
+_NO_POINTS = np.zeros((0, 3))  # a gradient argument that is not written
+_NO_BLOCKS = np.zeros((0, 3, 3))  # Hessian blocks that are not written
 
 
 class InfeasibleContactError(InvalidParameterError):
@@ -289,6 +291,7 @@ class ContactPotential:
         self._obstacle_points = np.array(pts, dtype=float).reshape(-1, 3)
         self._round = [o for _, o in kinds]
         self._floors = [o for o in contact.obstacles if isinstance(o, Floor)]
+        self._floor_normals = [np.asarray(f.normal, dtype=float) for f in self._floors]
         if contact.stiffness is not None:
             self.kappa = float(contact.stiffness)
         else:
@@ -332,7 +335,7 @@ class ContactPotential:
         """The :class:`~rotomorph.contact.friction.FrictionLag` of configuration ``x0``."""
         x0 = np.ascontiguousarray(x0, dtype=float)
         cand = self.candidates(x0)
-        xe = self._extended(x0)
+        xe = self._extended(x0).copy()  # kept by the lag
         nodes, weights, bases, force = [], [], [], []
         near = pair_distances(xe, cand.quads) < cand.dmin + self.dhat
         for p in np.flatnonzero(near):
@@ -374,6 +377,9 @@ class ContactPotential:
 
     # ------------------------------------------------------------------ candidates
     def _extended(self, x: FloatArray) -> FloatArray:
+        """Nodes and obstacle points ``(N + O, 3)`` (read only: ``x`` itself when ``O = 0``)."""
+        if not len(self._obstacle_points):
+            return np.ascontiguousarray(x, dtype=float)
         return np.ascontiguousarray(np.vstack([x, self._obstacle_points]), dtype=float)
 
     def candidates(self, x: FloatArray, margin: float = 0.0) -> _Candidates:
@@ -387,12 +393,12 @@ class ContactPotential:
         return self._reused(x, margin)[0].cand
 
     def _reused(self, x: FloatArray, margin: float = 0.0) -> tuple[_Reuse, FloatArray | None]:
-        """The reused candidate set of :meth:`candidates` and each node's motion since it was
-        found (mm; None when found here)."""
+        """The reused candidate set of :meth:`candidates` and each point's motion since it was
+        found (mm, ``(N + O,)``, 0 for obstacle points; None when found here)."""
         cache = self._cache
         if cache is not None and cache.near.x.shape == x.shape:
-            moved = np.sqrt(((x - cache.near.x) ** 2).sum(axis=1))
-            move = float(moved.max()) if len(x) else 0.0
+            moved = np.empty(len(x) + len(self._obstacle_points))
+            move = float(node_motions(x, cache.near.x, moved))
             if 2.0 * move + margin <= cache.near.pad:
                 return cache, moved
         pad = max(float(margin), self._pad)
@@ -541,15 +547,14 @@ class ContactPotential:
     ) -> tuple[float, FloatArray | None, HessianBlocks | None]:
         """:meth:`evaluate` with the Hessian as its local blocks (:class:`HessianBlocks`)."""
         x = np.ascontiguousarray(x, dtype=float)
-        reuse, moved = self._reused(x)
+        reuse, move = self._reused(x)
         cand = reuse.cand
         xe = self._extended(x)
-        grad = np.zeros_like(xe)
+        grad = np.zeros_like(xe) if need_grad else _NO_POINTS  # (written only with need_grad)
         # the pairs that may be within reach: their distance where the candidates were found
         # less their nodes' motions since (the others carry no energy)
-        move = np.zeros(len(xe))
-        if moved is not None:
-            move[: self.n_nodes] = moved
+        if move is None:
+            move = np.zeros(len(xe))
         near = within_reach(cand.quads, reuse.dist, move, cand.dmin + self.dhat)
         quads, dmin = cand.quads[near], cand.dmin[near]
         weight, mollify = cand.weight[near], cand.mollify[near]
@@ -560,27 +565,28 @@ class ContactPotential:
         )  # fmt: skip
         if not np.isfinite(energy):
             return np.inf, None, None
-        # Hessian blocks of the active pairs only (the candidate set is padded)
-        active = np.flatnonzero(dist < dmin + self.dhat)
-        quads = np.ascontiguousarray(quads[active])
-        hloc = np.zeros((len(active) if need_hess else 0, 12, 12))
-        if need_hess and len(active):
-            pair_barrier(
-                xe, quads, dmin[active], weight[active], mollify[active], self.dhat, self.kappa,
-                False, int(need_hess), grad, hloc, np.empty(len(active)),
-            )  # fmt: skip
+        if need_hess:  # Hessian blocks of the active pairs only (the candidate set is padded)
+            active = np.flatnonzero(dist < dmin + self.dhat)
+            quads = np.ascontiguousarray(quads[active])
+            hloc = np.zeros((len(active), 12, 12))
+            if len(active):
+                pair_barrier(
+                    xe, quads, dmin[active], weight[active], mollify[active], self.dhat,
+                    self.kappa, False, int(need_hess), grad, hloc, np.empty(len(active)),
+                )  # fmt: skip
         blocks = []
-        for f, (nodes, dmin, weight) in zip(self._floors, cand.floors, strict=True):
-            blk = np.zeros((len(nodes) if need_hess else 0, 3, 3))
+        for normal, f, (nodes, dmin, weight) in zip(
+            self._floor_normals, self._floors, cand.floors, strict=True
+        ):
+            blk = np.zeros((len(nodes), 3, 3)) if need_hess else _NO_BLOCKS
             e = plane_barrier(
-                xe, nodes, np.asarray(f.normal), f.height, dmin, weight, self.dhat, self.kappa,
-                need_grad, int(need_hess), grad, blk, np.empty(len(nodes)),
+                xe, nodes, normal, f.height, dmin, weight, self.dhat, self.kappa, need_grad,
+                int(need_hess), grad, blk, np.empty(len(nodes)),
             )  # fmt: skip
             if not np.isfinite(e):
                 return np.inf, None, None
             energy += e
             blocks.append(blk)
-        fl_h = np.concatenate(blocks) if blocks else np.zeros((0, 3, 3))
         if self._lag is not None:
             ef, gf, hf = friction_energy(self._lag, xe, need_grad, bool(need_hess))
             energy += ef
@@ -597,7 +603,9 @@ class ContactPotential:
                 quads=np.ascontiguousarray(quads, dtype=np.int64),
                 pair=np.ascontiguousarray(hloc),
                 nodes=np.ascontiguousarray(cand.floor_nodes, dtype=np.int64),
-                node=np.ascontiguousarray(fl_h),
+                node=np.ascontiguousarray(
+                    np.concatenate(blocks) if blocks else np.zeros((0, 3, 3))
+                ),
             )
         return float(energy), g, hess
 
@@ -626,13 +634,16 @@ class ContactPotential:
         """:meth:`step_bound` over the candidate pairs ``cand`` of the step; ``dist0``: their
         distances at ``x`` where known (NaN: not yet; filled as needed)."""
         xe = self._extended(x)
-        dxe = np.zeros_like(xe)
-        dxe[: self.n_nodes] = dx
+        if len(xe) == len(dx):  # no obstacle points
+            dxe = np.ascontiguousarray(dx, dtype=float)
+        else:
+            dxe = np.zeros_like(xe)
+            dxe[: self.n_nodes] = dx
         t = pair_step_bound(xe, dxe, cand.quads, cand.dmin, close_fraction, MAX_SUBSTEPS, dist0)
-        for f, (nodes, dmin, _) in zip(self._floors, cand.floors, strict=True):
-            bound = plane_step_bound(
-                xe, dxe, nodes, np.asarray(f.normal), f.height, dmin, close_fraction
-            )
+        for normal, f, (nodes, dmin, _) in zip(
+            self._floor_normals, self._floors, cand.floors, strict=True
+        ):
+            bound = plane_step_bound(xe, dxe, nodes, normal, f.height, dmin, close_fraction)
             t = min(t, bound)
         return float(t)
 
