@@ -98,3 +98,23 @@ def test_analysis_lists_the_permuted_upper_triangle_by_column_then_row(rng):
     np.testing.assert_array_equal(sym.bi, bi[order])
     np.testing.assert_array_equal(np.diff(sym.bp), np.bincount(bj[order], minlength=A.shape[0]))
     np.testing.assert_array_equal(A.data[sym.src[sym.bp[1:] - 1]], A.diagonal()[perm])
+
+
+@pytest.mark.parametrize(("n", "contacts"), [(2, 0), (3, 6), (5, 40), (5, 150)])
+def test_the_ordering_is_the_one_a_complete_factorization_finds(n, contacts, rng):
+    """The minimum-degree ordering taken from an incomplete factorization that drops every
+    off-diagonal entry is SuperLU's ordering from a complete factorization of the stand-in."""
+    import scipy.sparse.linalg as spla
+
+    from rotomorph.solve.sparse_cholesky import ordering
+
+    A = _lattice_pattern(n, contacts, rng)
+    pattern = sp.csc_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
+    degree = np.asarray(abs(pattern).sum(axis=0)).ravel()
+    lu = spla.splu(
+        (pattern + sp.diags(degree + 1.0)).tocsc(), permc_spec="MMD_AT_PLUS_A",
+        diag_pivot_thresh=0.0, options={"SymmetricMode": True},
+    )  # fmt: skip
+    perm = ordering(A)
+    assert np.array_equal(perm, np.argsort(lu.perm_c))
+    assert not np.array_equal(perm, np.arange(A.shape[0]))  # a real reordering
