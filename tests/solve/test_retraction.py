@@ -79,3 +79,35 @@ def test_least_squares_nodes_match_the_sparse_formula_to_the_bit(rng, fixed):
     expected[fix] = xd
     expected[free] = retract._lu.solve(np.ascontiguousarray(rhs))
     np.testing.assert_array_equal(y, expected)
+
+
+def test_split_and_join_of_a_step_are_the_layout_indexing(rng):
+    """The compiled gather/scatter of :meth:`RodObjective.retract` against NumPy indexing:
+    interleaved positions and twist angles, some DOFs fixed."""
+    from rotomorph.solve.retraction import join_step, split_step
+
+    nodes = 6
+    pos = 4 * np.arange(nodes)
+    theta = pos[:-1] + 3
+    count = 4 * nodes - 1
+    free = np.setdiff1d(np.arange(count), [0, 1, 2, 7])
+    u_base = rng.normal(size=count)
+    q, d = rng.normal(size=len(free)), rng.normal(size=len(free))
+    index = (pos[:, None] + np.arange(3)).ravel()
+    u, du = np.empty(count), np.empty(count)
+    x, dx = np.empty((nodes, 3)), np.empty((nodes, 3))
+    split_step(u_base, free, q, d, pos, u, du, x, dx)
+    u_ref = u_base.copy()
+    u_ref[free] = q
+    du_ref = np.zeros(count)
+    du_ref[free] = d
+    np.testing.assert_array_equal(u, u_ref)
+    np.testing.assert_array_equal(du, du_ref)
+    np.testing.assert_array_equal(x, u_ref[index].reshape(-1, 3))
+    np.testing.assert_array_equal(dx, du_ref[index].reshape(-1, 3))
+    moved = rng.normal(size=(nodes, 3))
+    out = np.empty(len(free))
+    join_step(u, du, 0.7, moved, pos, theta, free, out)
+    u_ref[index] = moved.ravel()
+    u_ref[theta] += 0.7 * du_ref[theta]
+    np.testing.assert_array_equal(out, u_ref[free])

@@ -32,3 +32,22 @@ def test_tangent_modes_slide_and_turn_a_body_on_the_floor(rng):
     r = x - x.mean(axis=0)
     np.testing.assert_allclose(moved[2], np.c_[-r[:, 1], r[:, 0], 0 * r[:, 0]], atol=1e-15)
     np.testing.assert_allclose(U[2][theta], t[:, 2])
+
+
+def test_tangent_modes_are_the_vectorised_formula_bit_for_bit(rng):
+    """The compiled fill writes what the NumPy expressions give (the projection of every
+    Newton step on a floor depends on these rows to the last bit)."""
+    nodes, twists = 30, 29
+    x = rng.normal(size=(nodes, 3)) * 50.0
+    t = rng.normal(size=(twists, 3))
+    normal = rng.normal(size=3)
+    pos = 4 * np.arange(nodes)
+    theta = pos[:-1] + 3
+    U = tangent_rigid_modes(x, t, normal, pos, theta, 4 * nodes)
+    n = normal / np.linalg.norm(normal)
+    coord = pos[:, None] + np.arange(3)
+    np.testing.assert_array_equal(U[2][coord], _cross(n, x - x.mean(axis=0)))
+    np.testing.assert_array_equal(U[2][theta], t @ n)
+    for k in (0, 1):
+        np.testing.assert_array_equal(U[k][coord], np.tile(U[k][pos[0] : pos[0] + 3], (nodes, 1)))
+    assert np.count_nonzero(U[:2][:, theta]) == 0

@@ -309,13 +309,40 @@ def tangent_rigid_modes(
     a /= np.linalg.norm(a)
     b = _cross(n, a)
     modes = np.zeros((3, ndof))
-    coord = pos_dof[:, None] + np.arange(3)
-    modes[0][coord] = a
-    modes[1][coord] = b
-    r = positions - positions.mean(axis=0)
-    modes[2][coord] = _cross(n, r)
-    modes[2][theta_dof] = tangents @ n
+    positions = np.ascontiguousarray(positions, dtype=float)
+    _fill_tangent_modes(
+        modes,
+        np.ascontiguousarray(pos_dof, dtype=np.int64),
+        np.ascontiguousarray(theta_dof, dtype=np.int64),
+        a,
+        b,
+        n,
+        positions,
+        positions.mean(axis=0),
+        tangents @ n,  # NumPy's (BLAS) products, as before
+    )
     return modes
+
+
+@njit(cache=True)
+def _fill_tangent_modes(
+    modes, pos_dof, theta_dof, a, b, n, positions, centroid, twist
+):  # pragma: no cover - compiled
+    """Rows of :func:`tangent_rigid_modes`: ``a``, ``b`` and ``n x (x - centroid)`` (the
+    products and differences of :func:`_cross`) on the positions, ``twist`` on the angles."""
+    for i in range(pos_dof.shape[0]):
+        p = pos_dof[i]
+        r0 = positions[i, 0] - centroid[0]
+        r1 = positions[i, 1] - centroid[1]
+        r2 = positions[i, 2] - centroid[2]
+        for k in range(3):
+            modes[0, p + k] = a[k]
+            modes[1, p + k] = b[k]
+        modes[2, p] = n[1] * r2 - n[2] * r1
+        modes[2, p + 1] = n[2] * r0 - n[0] * r2
+        modes[2, p + 2] = n[0] * r1 - n[1] * r0
+    for j in range(theta_dof.shape[0]):
+        modes[2, theta_dof[j]] = twist[j]
 
 
 def _cross(u: FloatArray, v: FloatArray) -> FloatArray:

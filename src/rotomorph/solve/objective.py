@@ -32,8 +32,10 @@ from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.pattern import hessian_pattern
 from rotomorph.solve.retraction import (
     EdgeRotationRetraction,
+    join_step,
     max_edge_rotation,
     remove_rigid_motion,
+    split_step,
 )
 from rotomorph.solve.sparse_cholesky import analyse
 
@@ -562,15 +564,15 @@ class RodObjective:
     def retract(self, q: FloatArray, d: FloatArray, alpha: float) -> FloatArray:
         """Step along ``d``: edges rotated (see :mod:`~rotomorph.solve.retraction`), twist
         angles moved linearly; fixed DOFs keep their values."""
-        u = self._u_base.copy()
-        u[self.free] = q
-        du = np.zeros_like(u)
-        du[self.free] = d
-        pos = u[self._pos_index].reshape(-1, 3)
-        dpos = du[self._pos_index].reshape(-1, 3)
-        u[self._pos_index] = self._retraction(pos, dpos, alpha).ravel()
-        u[self._theta_index] += alpha * du[self._theta_index]
-        return u[self.free]
+        lay = self.model.layout
+        u, du = np.empty(lay.count), np.empty(lay.count)
+        pos, dpos = np.empty((len(lay.pos), 3)), np.empty((len(lay.pos), 3))
+        split_step(self._u_base, self.free, q, d, lay.pos, u, du, pos, dpos)
+        out = np.empty(len(self.free))
+        join_step(
+            u, du, alpha, self._retraction(pos, dpos, alpha), lay.pos, lay.theta, self.free, out
+        )
+        return out
 
     def rigid_modes(self) -> FloatArray:
         """Rigid motions of a free body at the base ``(n_free, 6)``; ``(n_free, 0)`` if supported,

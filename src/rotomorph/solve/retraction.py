@@ -205,6 +205,35 @@ def _set_rows(out, rows, values):  # pragma: no cover - compiled
             out[rows[i], k] = values[i, k]
 
 
+@njit(cache=True)
+def split_step(u_base, free, q, d, pos_dof, u, du, x, dx):  # pragma: no cover - compiled
+    """Layout vectors ``u`` (``u_base`` with ``q`` on the free DOFs) and ``du`` (``d`` there,
+    0 elsewhere) and their node positions ``x``, ``dx`` (N, 3)."""
+    for i in range(u.shape[0]):
+        u[i] = u_base[i]
+        du[i] = 0.0
+    for i in range(free.shape[0]):
+        u[free[i]] = q[i]
+        du[free[i]] = d[i]
+    for n in range(pos_dof.shape[0]):
+        for k in range(3):
+            x[n, k] = u[pos_dof[n] + k]
+            dx[n, k] = du[pos_dof[n] + k]
+
+
+@njit(cache=True)
+def join_step(u, du, alpha, x, pos_dof, theta_dof, free, out):  # pragma: no cover - compiled
+    """Free DOFs ``out`` of the layout vector ``u`` with node positions ``x`` and twist angles
+    moved by ``alpha du``."""
+    for n in range(pos_dof.shape[0]):
+        for k in range(3):
+            u[pos_dof[n] + k] = x[n, k]
+    for j in range(theta_dof.shape[0]):
+        u[theta_dof[j]] += alpha * du[theta_dof[j]]
+    for i in range(free.shape[0]):
+        out[i] = u[free[i]]
+
+
 def _bfs_tree(edges: IntArray, n: int, root: int):  # type: ignore[no-untyped-def]
     """Breadth-first order, parents, parent edges and signs; None if not connected."""
     e = len(edges)
