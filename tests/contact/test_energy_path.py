@@ -1,5 +1,5 @@
 """The contact energy of a line-search trial (no gradient, no Hessian) is the full evaluation's,
-to the bit; the reused candidate set's node motions are NumPy's."""
+to the bit; the compiled node motions (candidate reuse, step sizes) are NumPy's."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import pytest
 
 from rotomorph.contact import Contact, ContactPotential, Floor, Sphere
 from rotomorph.contact.distance import node_motions
+from rotomorph.contact.potential import _largest_norm
 from rotomorph.design.network import Network
 
 
@@ -20,6 +21,9 @@ def test_node_motions_are_numpys_sums(rng):
     np.testing.assert_array_equal(out[:50], expected)
     np.testing.assert_array_equal(out[50:], 0.0)
     assert worst == expected.max()
+    squares = (x**2).sum(axis=1)
+    assert _largest_norm(x) == np.sqrt(squares).max() == np.sqrt(squares.max())
+    assert _largest_norm(np.zeros((0, 3))) == 0.0
     x[7, 1] = np.nan  # a NaN motion is the largest, as NumPy's max has it
     assert np.isnan(node_motions(x, ref, out))
 

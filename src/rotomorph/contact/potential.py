@@ -483,8 +483,9 @@ class ContactPotential:
                 np.zeros(len(node)),
             )
         if step is not None and len(step):
-            margin += float(np.sqrt((step**2).sum(axis=1).max()))
-        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
+            margin += _largest_norm(step)
+        if self._round:
+            mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
         half = 0.5 * self._max_length
         n = self.n_nodes
         for io, o in enumerate(self._round):
@@ -615,7 +616,7 @@ class ContactPotential:
         contact, stopping where a pair has closed ``close_fraction`` of its gap."""
         x = np.ascontiguousarray(x, dtype=float)
         dx = np.ascontiguousarray(dx, dtype=float)
-        disp = float(np.sqrt((dx**2).sum(axis=1)).max()) if len(dx) else 0.0
+        disp = _largest_norm(dx)
         if disp == 0.0:
             return 1.0
         cand = self._build_candidates(x, 0.0, step=dx, own=self._swept_pairs(x, dx))
@@ -759,6 +760,12 @@ def _excluded(
     if key not in per:
         per[key] = excluded_pairs(network.nodes, edges, radius, dhat, reach)
     return per[key]  # type: ignore[no-any-return]
+
+
+def _largest_norm(v: FloatArray) -> float:
+    """Largest row norm of ``v`` (N, 3) (mm; 0 when empty), NumPy's sums and square roots
+    (the largest root is the root of the largest sum), compiled."""
+    return float(node_motions(v, np.zeros_like(v), np.empty(len(v))))
 
 
 def _tangent_basis(normal: FloatArray) -> FloatArray:
