@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rotomorph.contact import Contact, ContactPotential, Floor, Sphere
-from rotomorph.contact.distance import node_motions
+from rotomorph.contact.distance import box_excess, box_growth, node_motions
 from rotomorph.contact.potential import _largest_norm
 from rotomorph.design.network import Network
 
@@ -26,6 +26,23 @@ def test_node_motions_are_numpys_sums(rng):
     assert _largest_norm(np.zeros((0, 3))) == 0.0
     x[7, 1] = np.nan  # a NaN motion is the largest, as NumPy's max has it
     assert np.isnan(node_motions(x, ref, out))
+
+
+def test_step_boxes_are_numpys(rng):
+    """How far a step's boxes reach beyond the reused candidates' positions, and how far a
+    trial lies outside the boxes its step bound swept: NumPy's element-wise values."""
+    for n in (1, 7, 40):
+        x = rng.normal(size=(n, 3))
+        x0 = x + 1e-3 * rng.normal(size=(n, 3))
+        x1 = x0 + 1e-2 * rng.normal(size=(n, 3))
+        y = x0 + rng.uniform(-0.1, 1.1, (n, 1)) * (x1 - x0) + 1e-4 * rng.normal(size=(n, 3))
+        grown = np.maximum(np.abs(x0 - x), np.abs(x1 - x)).max(axis=0)
+        np.testing.assert_array_equal(box_growth(x0, x1, x), grown)
+        outside = np.maximum(np.minimum(x0, x1) - y, y - np.maximum(x0, x1)).max()
+        assert box_excess(x0, x1, y) == outside
+    x0[3, 1] = np.nan  # NaN as NumPy's maxima have it: no reuse on it
+    assert np.isnan(box_growth(x0, x1, x)[1]) and not np.isnan(box_growth(x0, x1, x)[0])
+    assert np.isnan(box_excess(x0, x1, y))
 
 
 @pytest.mark.parametrize("friction", [0.0, 0.4], ids=["frictionless", "friction"])

@@ -250,6 +250,42 @@ def node_motions(x, x_ref, out):  # pragma: no cover - compiled
     return worst
 
 
+@njit(cache=True)
+def box_growth(x0, x1, x_ref):  # pragma: no cover - compiled
+    """Per axis (3,), the largest ``|x0 - x_ref|`` or ``|x1 - x_ref|`` over the nodes (mm):
+    how far the boxes of a step ``x0 -> x1`` reach beyond the nodes ``x_ref``; NaN on an axis
+    where a coordinate is."""
+    out = np.zeros(3)
+    for i in range(x_ref.shape[0]):
+        for k in range(3):
+            a = abs(x0[i, k] - x_ref[i, k])
+            b = abs(x1[i, k] - x_ref[i, k])
+            if a != a or b != b:
+                out[k] = np.nan  # (stays: no comparison with it holds)
+            elif a > out[k] or b > out[k]:
+                out[k] = max(a, b)
+    return out
+
+
+@njit(cache=True)
+def box_excess(start, end, x):  # pragma: no cover - compiled
+    """Largest amount (mm) by which a coordinate of ``x`` lies outside the interval between
+    its values in ``start`` and ``end`` (all (N, 3); negative when every one lies inside,
+    -inf when N = 0, NaN when any coordinate is)."""
+    worst = -np.inf
+    for i in range(x.shape[0]):
+        for k in range(3):
+            a = start[i, k]
+            b = end[i, k]
+            c = x[i, k]
+            if a != a or b != b or c != c:
+                return np.nan
+            v = max(min(a, b) - c, c - max(a, b))
+            if v > worst:
+                worst = v
+    return worst
+
+
 #: relative margin by which :func:`distance_bound` must clear a threshold before a caller skips
 #: the exact distance on it (far above the bound's round-off)
 BOUND_MARGIN = 1e-9

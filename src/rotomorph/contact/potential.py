@@ -27,7 +27,13 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.barrier import barrier, pair_barrier, plane_barrier
 from rotomorph.contact.broadphase import near_pairs, near_subset, within_reach
 from rotomorph.contact.ccd import pair_step_bound, plane_step_bound
-from rotomorph.contact.distance import closest_parameters, node_motions, pair_distances
+from rotomorph.contact.distance import (
+    box_excess,
+    box_growth,
+    closest_parameters,
+    node_motions,
+    pair_distances,
+)
 from rotomorph.contact.exclusion import excluded_pairs
 from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
@@ -195,7 +201,7 @@ class _NearSet:
         """
         if x0.shape != self.x.shape or len(x0) == 0:
             return False
-        delta = np.maximum(np.abs(x0 - self.x), np.abs(x1 - self.x)).max(axis=0)
+        delta = box_growth(x0, x1, self.x)
         return bool(2.0 * float(np.sqrt(delta @ delta)) <= (1.0 - 1e-6) * self.pad)
 
 
@@ -664,8 +670,7 @@ class ContactPotential:
         swept = self._swept
         if swept is not None and swept[0].shape == x0.shape and np.array_equal(swept[0], x0):
             start, end, cand, dist0 = swept
-            outside = np.maximum(np.minimum(start, end) - x1, x1 - np.maximum(start, end))
-            if len(x1) == 0 or float(outside.max()) <= SWEPT_SLACK * self.dhat:
+            if len(x1) == 0 or float(box_excess(start, end, x1)) <= SWEPT_SLACK * self.dhat:
                 return self._bound_on(x0, x1 - x0, cand, 1.0, dist0) >= 1.0
         return self.step_bound(x0, x1 - x0, close_fraction=1.0) >= 1.0
 
