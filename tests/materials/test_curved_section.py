@@ -132,3 +132,33 @@ def test_curved_states_survive_a_full_straight_memory(section, monkeypatch) -> N
     eps_par = np.linspace(-0.3, -0.1, n)
     eps_c, dk = section.curved_strains(0.0, eps_par, 0.1, 0.02, k0)
     assert eps_c.shape == (n,) and dk.shape == (n, 2) and np.all(np.isfinite(dk))
+
+
+def test_a_rows_result_does_not_depend_on_its_batch(section) -> None:  # type: ignore[no-untyped-def]
+    # a lattice's print states are solved in batches whose make-up depends on what was solved
+    # before (the states are remembered): each row must come out bit for bit the same alone,
+    # in any batch and at any position, or results depend on the order of earlier solves
+    rng = np.random.default_rng(7)
+    ax = section.axial
+    n = 13
+    eps = np.where(ax.active, rng.uniform(-0.3, 0.1, (n, 1)), rng.uniform(-0.05, 0.05, (n, 1)))
+    k0 = rng.uniform(-1.5, 1.5, (n, 2))
+    t = rng.uniform(-0.05, 0.1, n)
+    whole = ax.natural_curved(eps, k0, t)
+    order = rng.permutation(n)
+    shuffled = ax.natural_curved(eps[order], k0[order], t[order])
+    for i in range(n):
+        alone = ax.natural_curved(eps[i : i + 1], k0[i : i + 1], t[i : i + 1])
+        assert alone[0][0] == whole[0][i] and np.array_equal(alone[1][0], whole[1][i])
+    assert np.array_equal(shuffled[0], whole[0][order])
+    assert np.array_equal(shuffled[1], whole[1][order])
+    # and the Janus section's curved states (Turner's transverse strain included), solved as
+    # one batch and then one by one with its memory of solved states emptied in between
+    states = (rng.uniform(0.0, 0.5, n), rng.uniform(-0.4, -0.1, n), rng.uniform(0.0, 0.2, n))
+    janus = filament_section(RADIUS, 2.0, 1.5)
+    janus._curved.clear()
+    batch = janus.curved_strains(*states, np.zeros(n), k0)
+    for i in range(n):
+        janus._curved.clear()
+        one = janus.curved_strains(*(s[i] for s in states), 0.0, k0[i : i + 1])
+        assert one[0][0] == batch[0][i] and np.array_equal(one[1][0], batch[1][i])

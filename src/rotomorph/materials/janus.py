@@ -198,7 +198,8 @@ class FilamentSection:
         sin2 = 1.0 - 1.0 / denom
         eps_t = np.where(act, et + 0.5 * (ep - et) * sin2, eq)  # mean in-plane eigenstrain
         ew = self.axial.modulus * self.axial.weights
-        transverse = eps_t @ ew / self.axial.axial_stiffness
+        # (einsum, not a matrix product: a row's sum must not depend on the batch's other rows)
+        transverse = np.einsum("iq,q->i", eps_t, ew) / self.axial.axial_stiffness
         k0 = states[:, 4:6]
         eps_c, dkappa = self.axial.natural_curved(eps_zz, k0, transverse)
         out = np.column_stack([eps_c, dkappa])

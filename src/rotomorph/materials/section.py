@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
+from numba import njit
 
 from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidParameterError
@@ -166,25 +167,26 @@ class AxialSection:
         eps = np.asarray(eigenstrain, dtype=float)
         k0 = np.asarray(curvature, dtype=float)
         x = self.points
-        factor = 1.0 - k0 @ x.T  # (n, Q)
-        if np.any(factor <= 0.0):
+        ew = self.modulus * self.weights
+        # the quadrature sums, row by row in a fixed order: a row's result does not depend on
+        # the other rows of the batch (the states of a lattice are solved in batches whose
+        # make-up depends on what was solved before)
+        m, rhs, shortest = _curved_sums(
+            np.ascontiguousarray(eps.reshape(-1, len(ew))),
+            np.ascontiguousarray(k0.reshape(-1, 2)),
+            np.ascontiguousarray(x),
+            np.ascontiguousarray(ew),
+        )
+        if np.any(shortest <= 0.0):
             raise InvalidParameterError(
                 "curvature", "printed radius of curvature is smaller than the section's extent"
             )
-        ew = self.modulus * self.weights
-        w = ew / factor
-        # the quadrature sums as matrix products (n, Q) @ (Q, k)
-        xx = (x[:, :, None] * x[:, None, :]).reshape(-1, 4)
-        m = np.empty((*eps.shape[:-1], 3, 3))
-        m[..., 0, 0] = w.sum(axis=-1)
-        m[..., 0, 1:] = m[..., 1:, 0] = -(w @ x)
-        m[..., 1:, 1:] = (w @ xx).reshape(-1, 2, 2)
-        rhs = np.empty((*eps.shape[:-1], 3))
-        rhs[..., 0] = eps @ ew
-        rhs[..., 1:] = -(eps @ (ew[:, None] * x))
         sol = np.linalg.solve(m, rhs[..., None])[..., 0]
         eps_g, g = sol[..., 0], sol[..., 1:]
-        eps_c = (eps_g - g @ self.centroid) / (1.0 - k0 @ self.centroid)
+        c = self.centroid  # (products written out: a matrix product rounds by batch size)
+        eps_c = (eps_g - (g[..., 0] * c[0] + g[..., 1] * c[1])) / (
+            1.0 - (k0[..., 0] * c[0] + k0[..., 1] * c[1])
+        )
         t = np.asarray(transverse, dtype=float)[..., None]
         return eps_c, g - t * k0
 
@@ -218,3 +220,47 @@ def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> Axi
     d = xy - c
     i_e = (ew[:, None, None] * d[:, :, None] * d[:, None, :]).sum(axis=0)
     return AxialSection(a_e, c, i_e, xy, w, act, e)
+
+
+@njit(cache=True)
+def _curved_sums(eps, k0, x, ew):  # pragma: no cover - compiled
+    """The curved-bar system of :meth:`AxialSection.natural_curved` per row: ``(n, 3, 3)``
+    matrices and ``(n, 3)`` right-hand sides, each summed over the quadrature points in
+    their order (``w = E dA / (1 - k0.x)``), and the smallest relative fibre length
+    ``1 - k0.x`` of each row ``(n,)`` (the system is meaningless where it is not positive)."""
+    n, nq = eps.shape
+    m = np.zeros((n, 3, 3))
+    rhs = np.zeros((n, 3))
+    shortest = np.empty(n)
+    for i in range(n):
+        s0 = s1 = s2 = s11 = s12 = s22 = r0 = r1 = r2 = 0.0
+        low = np.inf
+        for q in range(nq):
+            x0 = x[q, 0]
+            x1 = x[q, 1]
+            f = 1.0 - (k0[i, 0] * x0 + k0[i, 1] * x1)
+            low = min(low, f)
+            if f <= 0.0:
+                continue  # reported through ``shortest``
+            w = ew[q] / f
+            s0 += w
+            s1 += w * x0
+            s2 += w * x1
+            s11 += w * x0 * x0
+            s12 += w * x0 * x1
+            s22 += w * x1 * x1
+            e = eps[i, q] * ew[q]
+            r0 += e
+            r1 += e * x0
+            r2 += e * x1
+        m[i, 0, 0] = s0
+        m[i, 0, 1] = m[i, 1, 0] = -s1
+        m[i, 0, 2] = m[i, 2, 0] = -s2
+        m[i, 1, 1] = s11
+        m[i, 1, 2] = m[i, 2, 1] = s12
+        m[i, 2, 2] = s22
+        rhs[i, 0] = r0
+        rhs[i, 1] = -r1
+        rhs[i, 2] = -r2
+        shortest[i] = low
+    return m, rhs, shortest
