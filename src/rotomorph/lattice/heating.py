@@ -780,8 +780,8 @@ def _lift_probe(
     orientations), toppled as a rigid body into the pose it rests in under its weight
     (:func:`~rotomorph.lattice.resting.resting_rotation`; a saddle laid on its two low corners
     rocks over), where its elastic equilibrium under its weight is solved with the ramp's
-    contact model. It returns ``(best lifted result or
-    None, its energy minus the resting one or None, Newton iterations spent)``. A lifted
+    contact model. It returns ``(best lifted result or None, its energy minus the resting
+    one or None, Newton iterations spent)``. A lifted
     result is returned only if it is certified stable, lower in total energy (elastic +
     weight + barrier) and actually off the floor. A lift found inside a halved or path-check
     sub-step is recorded in the row of the step it leads to (``_gaps_per_step``).
@@ -821,8 +821,12 @@ def _lift_probe(
     # 2. laid on the floor either way up, it settles under its weight
     best: StaticResult | None = None
     gap_floor = float(floor.height_of(resting.positions).min())
+    # each edge weighs its printed mass: half of its printed length to each end node
+    net = lattice.network
+    half = 0.5 * np.linalg.norm(net.nodes[net.edges[:, 1]] - net.nodes[net.edges[:, 0]], axis=1)
+    weight = np.asarray(np.bincount(net.edges.ravel(), np.repeat(half, 2), net.n_nodes), float)
     for flip in (False, True):
-        start = _laid_on(free.state, floor, gap_floor, flip, lattice.network.edges)
+        start = _laid_on(free.state, floor, gap_floor, flip, weight)
         try:
             trial = solve_static(
                 model, supports, loads, initial=start, options=options, contact=settings
@@ -937,12 +941,11 @@ def _rise(floor: Floor, lattice: Lattice, positions: FloatArray) -> float:
     return float((floor.height_of(positions) - floor.height_of(lattice.network.nodes)).max())
 
 
-def _laid_on(state: State, floor: Floor, height: float, flip: bool, edges: IntArray) -> State:
+def _laid_on(state: State, floor: Floor, height: float, flip: bool, weight: FloatArray) -> State:
     """``state`` moved rigidly (turned upside down about the lattice's x axis when ``flip``),
-    toppled as a rigid body into the pose where it rests on ``floor`` under its weight (uniform
-    per unit length of the network's ``edges``; :func:`resting_rotation`) with its centre of
-    mass over the same point of the floor, and lowered so that its lowest node is ``height``
-    (mm) above ``floor``."""
+    toppled as a rigid body into the pose where it rests on ``floor`` under the nodal weights
+    ``weight`` (:func:`resting_rotation`) with its centre of mass over the same point of the
+    floor, and lowered so that its lowest node is ``height`` (mm) above ``floor``."""
     n = np.asarray(floor.normal, dtype=float)
     rot = np.eye(3)
     if flip:  # a half turn about an axis in the floor's plane
@@ -950,8 +953,6 @@ def _laid_on(state: State, floor: Floor, height: float, flip: bool, edges: IntAr
         rot = 2.0 * np.outer(a, a) - np.eye(3)
     centre = state.positions.mean(axis=0)
     pos = (state.positions - centre) @ rot.T + centre
-    half = 0.5 * np.linalg.norm(pos[edges[:, 1]] - pos[edges[:, 0]], axis=1)
-    weight = np.asarray(np.bincount(edges.ravel(), np.repeat(half, 2), len(pos)), dtype=float)
     turn, shift = resting_rotation(pos, weight, n)
     before = weight @ pos / weight.sum()
     pos = pos @ turn.T + shift
