@@ -244,6 +244,17 @@ def polyline_strains(
     return k1, k2, tw, 0.5 * (lengths[:-1] + lengths[1:])
 
 
+def plane_basis(normal: FloatArray) -> FloatArray:
+    """Orthonormal ``(3, 2)`` basis ``(e1, e2)`` of the plane perpendicular to the unit
+    ``normal``, right-handed with it (``e2 = normal x e1``)."""
+    n = np.asarray(normal, dtype=float)
+    a = np.cross(n, [1.0, 0.0, 0.0])
+    if np.linalg.norm(a) < 0.5:
+        a = np.cross(n, [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a)
+    return np.stack([a, np.cross(n, a)], axis=1)
+
+
 def best_rotation(points: FloatArray, target: FloatArray) -> FloatArray:
     """The proper rotation ``R`` (3 x 3) minimising ``sum_i |R p_i - q_i|^2`` for centred
     ``(N, 3)`` point sets ``p`` (``points``) and ``q`` (``target``) with corresponding rows

@@ -39,6 +39,7 @@ from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
+from rotomorph.geometry import plane_basis
 
 __all__ = ["Contact", "ContactPotential", "HessianBlocks", "InfeasibleContactError"]
 
@@ -354,7 +355,7 @@ class ContactPotential:
             if lam > 0:
                 nodes.append([i0, i1, j0, j1])
                 weights.append(w)
-                bases.append(_tangent_basis(r / d))
+                bases.append(plane_basis(r / d))
                 force.append(lam)
         for f, (fn, fd, fw) in zip(self._floors, cand.floors, strict=True):
             h = f.height_of(x0[fn])
@@ -363,7 +364,7 @@ class ContactPotential:
                 if lam > 0:
                     nodes.append([fn[k]] * 4)
                     weights.append(np.array([1.0, 0.0, 0.0, 0.0]))
-                    bases.append(_tangent_basis(np.asarray(f.normal)))
+                    bases.append(plane_basis(np.asarray(f.normal)))
                     force.append(lam)
         return FrictionLag(
             nodes=np.array(nodes, dtype=np.int64).reshape(-1, 4),
@@ -771,15 +772,6 @@ def _largest_norm(v: FloatArray) -> float:
     """Largest row norm of ``v`` (N, 3) (mm; 0 when empty), NumPy's sums and square roots
     (the largest root is the root of the largest sum), compiled."""
     return float(node_motions(v, np.zeros_like(v), np.empty(len(v))))
-
-
-def _tangent_basis(normal: FloatArray) -> FloatArray:
-    """Orthonormal ``(3, 2)`` basis of the plane perpendicular to unit ``normal``."""
-    a = np.cross(normal, [1.0, 0.0, 0.0])
-    if np.linalg.norm(a) < 0.5:
-        a = np.cross(normal, [0.0, 1.0, 0.0])
-    a /= np.linalg.norm(a)
-    return np.stack([a, np.cross(normal, a)], axis=1)
 
 
 def _point_segment_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:

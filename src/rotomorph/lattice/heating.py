@@ -953,12 +953,10 @@ def _laid_on(state: State, floor: Floor, height: float, flip: bool, weight: Floa
         rot = 2.0 * np.outer(a, a) - np.eye(3)
     centre = state.positions.mean(axis=0)
     pos = (state.positions - centre) @ rot.T + centre
-    turn, shift = resting_rotation(pos, weight, n)
-    before = weight @ pos / weight.sum()
-    pos = pos @ turn.T + shift
+    turn, _ = resting_rotation(pos, weight, n)
+    centre = weight @ pos / weight.sum()  # turned about its centre of mass, which stays put
+    pos = (pos - centre) @ turn.T + centre
     rot = turn @ rot
-    moved = weight @ pos / weight.sum() - before
-    pos -= moved - (moved @ n) * n  # back over the same point of the floor
     pos += (height - float(floor.height_of(pos).min())) * n
     return replace(
         state, positions=pos, tangents=state.tangents @ rot.T, directors=state.directors @ rot.T

@@ -21,6 +21,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
+from rotomorph.geometry import best_rotation, plane_basis
 
 __all__ = ["resting_rotation"]
 
@@ -68,11 +69,9 @@ def resting_rotation(
     size = float(np.ptp(x0, axis=0).max()) or 1.0
     body = _Body(w / total, n, float((x0 @ n).min()), 1e-9 * size)
     x = body.topple(x0, depth=2)
-    # the rigid motion x0 -> x (Kabsch; exact up to round-off for a rigid motion)
+    # the rigid motion x0 -> x (exact up to round-off)
     c0, c1 = body.weights @ x0, body.weights @ x
-    U, _, Vt = np.linalg.svd((x0 - c0).T @ (x - c1))
-    D = np.diag([1.0, 1.0, float(np.sign(np.linalg.det(U @ Vt)))])
-    R = (U @ D @ Vt).T
+    R = best_rotation(x0 - c0, x - c1)
     return R, c1 - c0 @ R.T
 
 
@@ -105,11 +104,7 @@ class _Body:
                 across = np.cross(n, along / np.linalg.norm(along))
                 tips = [across, -across]
             else:
-                e1 = np.cross(n, [1.0, 0.0, 0.0])
-                if np.linalg.norm(e1) < 0.5:
-                    e1 = np.cross(n, [0.0, 1.0, 0.0])
-                e1 /= np.linalg.norm(e1)
-                e2 = np.cross(n, e1)
+                e1, e2 = plane_basis(n).T
                 tips = [e1, -e1, e2, -e2]
             best: FloatArray | None = None
             for h in tips:
@@ -147,11 +142,7 @@ def _nearest_on_support(
 ) -> tuple[FloatArray, float]:
     """The point of the support polygon (convex hull of ``support`` in the plane) nearest to
     the vertical through ``c``, on the plane, and the polygon's area (mm²)."""
-    e1 = np.cross(n, [1.0, 0.0, 0.0])
-    if np.linalg.norm(e1) < 0.5:
-        e1 = np.cross(n, [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(n, e1)
+    e1, e2 = plane_basis(n).T
     origin = support[0] - (support[0] @ n) * n
     uv = np.column_stack(((support - origin) @ e1, (support - origin) @ e2))
     target = np.array([(c - origin) @ e1, (c - origin) @ e2])
