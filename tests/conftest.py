@@ -13,3 +13,31 @@ def _result_cache(tmp_path_factory: pytest.TempPathFactory) -> None:
     tests of one session, never read from or written to the user's ~/.cache)."""
     if "ROTOMORPH_CACHE_DIR" not in os.environ:
         os.environ["ROTOMORPH_CACHE_DIR"] = str(tmp_path_factory.mktemp("rotomorph-cache"))
+
+
+#: Set to 1 by ``.ci/run``: a referee tool that is missing fails the run instead of skipping.
+REQUIRE_REFEREES = os.environ.get("ROTOMORPH_REQUIRE_REFEREES") == "1"
+
+
+@pytest.fixture(scope="session")
+def require_tool():
+    """A function ``require_tool(executable, install)`` returning the tool's path.
+
+    Referee tests run software outside the project (a controller's own interpreter, a real
+    browser). Where the tool is not installed they are skipped with the install line in the
+    reason (``pytest -ra`` lists it); under ``ROTOMORPH_REQUIRE_REFEREES=1`` (what ``.ci/run``
+    sets after installing them) a missing tool fails the test, so CI can never pass by
+    skipping its referees.
+    """
+    import shutil
+
+    def _require(executable: str, install: str) -> str:
+        path = shutil.which(executable)
+        if path is not None:
+            return path
+        message = f"referee '{executable}' is not installed ({install})"
+        if REQUIRE_REFEREES:
+            pytest.fail(message + "; ROTOMORPH_REQUIRE_REFEREES=1 requires it", pytrace=False)
+        pytest.skip(message + "; .ci/run installs it and requires it")
+
+    return _require
