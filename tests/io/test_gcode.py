@@ -83,7 +83,8 @@ def test_dialect_idioms():
     # and on every marlin travel
     assert "G1 F3\n" in texts["aerotech"] and " F180\n" in texts["rs274"]
     assert all(" F" in ln for ln in texts["marlin"].splitlines() if ln.startswith(("G0", "G1")))
-    assert "Call setPress P5 Q30\nCall togglePress P5\n" in texts["aerotech_nordson"]
+    assert "Call setPress P5 Q30\nCall setDispense P5 Q1\n" in texts["aerotech_nordson"]
+    assert "togglePress" not in texts["aerotech_nordson"]  # explicit states, never a toggle
     assert "M68 E5 Q30.000\nM64 P5\n" in texts["rs274"] and "M65 P5" in texts["rs274"]
     assert "M42 P5 S76\n" in texts["marlin"]  # 30 psi of 100 at PWM 255
     for text in texts.values():
@@ -116,7 +117,9 @@ def test_pure_passive_drives_only_its_channel():
     line = PrintPath.line((10, 10, 0), (12, 10, 0), 0.5)
     prog = PrintProgram.from_rotation(line, 3.0, 0.0, active_fraction=0.0)
     text = gcode_text([prog], GOLDEN_MACHINES["aerotech"], process=Process(0.0, 25.0))
-    assert "P5" not in text and "Call setAlicatPress P6 Q25" in text
+    # the active channel is only ever set off (at the start, explicitly), never driven
+    assert [ln for ln in text.splitlines() if "P5" in ln] == ["Call setAlicatPress P5 Q0"]
+    assert "Call setAlicatPress P6 Q25" in text
     with pytest.raises(InvalidParameterError, match="passive_pressure"):
         gcode_text([prog], GOLDEN_MACHINES["aerotech"], process=Process(25.0, 0.0))
 
@@ -128,7 +131,7 @@ def test_rotary_rebased_between_filaments():
         PrintProgram.from_rotation(line.translated((0, 5 * k, 0)), 3.0, 20.0) for k in range(3)
     ]
     for rebase in ("g92", "unwind"):
-        machine = MachineProfile(rotary_rebase=rebase)
+        machine = MachineProfile(rotary_rebase=rebase, continuous_rotation=True, max_turns=40)
         text = gcode_text(progs, machine)
         report = check_gcode(text, machine)
         assert report.max_start_turns <= 1.0
@@ -220,7 +223,7 @@ def test_write_and_read_file(tmp_path):
 @pytest.mark.parametrize(
     ("mutate", "match"),
     [
-        (lambda t: t.replace("G90\n", "G90\nG28\n", 1), "unexpected command"),
+        (lambda t: t.replace("VELOCITY ON\n", "VELOCITY ON\nG28\n", 1), "unexpected command"),
         (lambda t: t.replace("Call setAlicatPress P5 Q30", "Call togglePress P5", 1), "unexpected"),
         (lambda t: t.replace(" C95.492966\n", " C95.492966 E1\n", 1), "unexpected word"),
         (
@@ -229,9 +232,9 @@ def test_write_and_read_file(tmp_path):
         ),
         (lambda t: re.sub(r"; filament 0 [^\n]*\n", "", t, count=1), "without a '; filament"),
         (lambda t: t.replace("P6 Q30\n", "P6 Q30\nG0 Z5\n", 1), "travel move .G0. with a pressure"),
-        (lambda t: t.replace("Call setAlicatPress P5 Q0\n", "", 1), "inside another filament"),
+        (lambda t: t.replace("Call setAlicatPress P5 Q0\n", "", 2), "inside another filament"),
         (lambda t: t.replace("P6 Q30", "P7 Q30", 1), "unknown pressure port 7"),
-        (lambda t: t.replace("G0 X12 Y12", "G0 X12 Y12 C5", 1), "rotary word on a rapid"),
+        (lambda t: t.replace("G1 X12 Y12\n", "G0 X12 Y12 C5\n", 1), "rotary word on a rapid"),
         (lambda t: t.replace("G1 X10.5 Y10 C95.492966", "G1 C95.492966", 1), "rotary-only"),
         (lambda t: t.replace("G71\n", "", 1), "setup_lines"),
         (lambda t: t.replace("\nM2\n", "\n", 1), "must end with"),
@@ -269,7 +272,7 @@ def _without_rebase(text: str) -> str:
         (lambda t: t.replace("G1 F1.5\n", "G1 F300\n", 1), "max_feed"),
         (lambda t: t.replace("G1 F1.5\n", "G1 F0.001\n", 1), "min_feed"),
         (lambda t: t.replace("P6 Q30", "P6 Q300", 1), "max_pressure"),
-        (lambda t: t.replace("G0 X10 Y10", "G0 X-10 Y10", 1), "envelope_min"),
+        (lambda t: t.replace("G1 X10 Y10\n", "G1 X-10 Y10\n", 1), "envelope_min"),
         (lambda t: _without_rebase(t), "rotary_rebase"),
     ],
 )
@@ -297,7 +300,15 @@ def test_machine_profile(tmp_path):
     with pytest.raises(InvalidParameterError, match="rotary_axis"):
         MachineProfile(rotary_axis="F")
     with pytest.raises(InvalidParameterError, match="dialect"):
-        MachineProfile(dialect="klipper")
+        MachineProfile(dialect="klipper")  # Klipper is a controller of the marlin dialect
+    with pytest.raises(InvalidParameterError, match="'controller'"):
+        MachineProfile(dialect="rs274", controller="klipper")
+    with pytest.raises(InvalidParameterError, match="'rotary_rebase'.*Klipper"):
+        MachineProfile(dialect="marlin", controller="klipper", rotary_rebase="g92")
+    with pytest.raises(InvalidParameterError, match="'rotary_rebase'.*rotary union"):
+        MachineProfile(continuous_rotation=False, rotary_rebase="g92")
+    assert MachineProfile(dialect="marlin", controller="klipper").rotary_rebase == "unwind"
+    assert MachineProfile(continuous_rotation=False).rotary_rebase == "unwind"
     with pytest.raises(InvalidParameterError, match="unknown setting"):
         MachineProfile.from_dict({"speed": 1})
     with pytest.raises(InvalidParameterError, match="pressure_template"):

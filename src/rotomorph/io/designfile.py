@@ -272,10 +272,19 @@ class _Process(_Model):
                 passive_conductance=nozzle.passive_conductance,
                 **dwells,
             )
+        flow = nozzle.active_conductance is not None or nozzle.passive_conductance is not None
+        unset = [  # defaults nobody set: flagged in the program's header and by `gcode`
+            k
+            for k in ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell")
+            if getattr(self, k) is None
+            and k not in nozzle.model_fields_set
+            and not (flow and k.endswith("_pressure"))
+        ]
         return Process(
             base.active_pressure if self.active_pressure is None else self.active_pressure,
             base.passive_pressure if self.passive_pressure is None else self.passive_pressure,
             **dwells,
+            placeholders=tuple(unset),
         )
 
 

@@ -51,13 +51,17 @@ import numpy as np
 import rotomorph
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidParameterError, MachineLimitError, MaterialError
+from rotomorph.io import gcode_aerotech
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.machine import MachineProfile, check_line, fill_template
 from rotomorph.io.print_order import machine_order
 from rotomorph.materials.material import get_material, known_materials
 
 __all__ = [
+    "MAX_LINE",
+    "PLACEHOLDER_SETTINGS",
     "Process",
+    "placeholder_settings",
     "check_materials",
     "gcode_text",
     "pressure_lines",
@@ -67,6 +71,11 @@ __all__ = [
 
 _EPS = 1e-9
 _DIGITS = 6  # decimals of position and angle words (mm, deg or rad)
+#: Longest line written (characters). LinuxCNC's interpreter refuses lines over 252 characters
+#: (comments included); every dialect is kept below this.
+MAX_LINE = 250
+#: Process settings that are placeholders unless a design (or the caller) sets them.
+PLACEHOLDER_SETTINGS = ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell")
 
 
 class _Num(float):
@@ -101,14 +110,24 @@ class Process:
         Dwell after pressure-on before the first move (s), so the ink reaches the tip.
     release_dwell
         Dwell after pressure-off before the lift (s), so the flow stops before the nozzle moves.
+    placeholders
+        Names of the settings above that nobody set (defaults, not the lab's values): the
+        program's header flags them and ``rotomorph gcode`` says so on stderr.
     """
 
     active_pressure: float = 30.0
     passive_pressure: float = 30.0
     prime_dwell: float = 0.0
     release_dwell: float = 0.0
+    placeholders: tuple[str, ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "placeholders", tuple(self.placeholders))
+        unknown = set(self.placeholders) - set(PLACEHOLDER_SETTINGS)
+        if unknown:
+            raise InvalidParameterError(
+                "Process.placeholders", f"must name settings of {PLACEHOLDER_SETTINGS}; got {sorted(unknown)}"
+            )
         for name in ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
@@ -222,9 +241,10 @@ def pressure_lines(m: MachineProfile, port: int, psi: float, on: bool) -> list[s
     """The lines that turn channel ``port`` on at ``psi`` (or off) in the profile's idiom."""
     if m.pressure_idiom == "alicat":
         return [f"Call setAlicatPress P{port} Q{_num(psi if on else 0.0, 3)}"]
-    if m.pressure_idiom == "nordson":
-        toggle = f"Call togglePress P{port}"
-        return [f"Call setPress P{port} Q{_num(psi, 3)}", toggle] if on else [toggle]
+    if m.pressure_idiom == "nordson":  # explicit states, never a blind toggle
+        if not on:
+            return [f"Call setDispense P{port} Q0"]
+        return [f"Call setPress P{port} Q{_num(psi, 3)}", f"Call setDispense P{port} Q1"]
     values = {k: (_Num(v) if k != "pwm" else v) for k, v in m.pressure_values(psi).items()}
     setpoint = fill_template(m.pressure_template or "", port=port, **values)
     if not m.valve_on_template:
@@ -266,6 +286,8 @@ class _Writer:
     shift: float = 0.0  # total G92 re-basing of the rotary word
     feed: float | None = None  # modal F (aerotech), mm/s
     time: float = 0.0
+    wound: float = 0.0  # largest |physical nozzle angle| (rotary words + G92 shifts)
+    turned: float = 0.0  # total |rotation| of the nozzle (rotary-word units)
 
     def emit(self, *lines: str) -> None:
         self.lines.extend(lines)
@@ -284,18 +306,35 @@ class _Writer:
         return " ".join(words)
 
     def rapid(self, xyz: np.ndarray, axes: str) -> None:
-        """A travel move (no rotary word), at travel_feed on marlin; none if already there."""
+        """A travel move (no rotary word); none if already there.
+
+        ``G0`` on LinuxCNC (the controller's rapid rate), ``G0 … F<travel>`` on Marlin-like
+        firmware (which run G0 at the last feed), ``G1`` at ``travel_feed`` on Aerotech (as
+        mecode travels: an A3200 ``G0`` runs at its own rapid rate, not the profile's).
+        """
         m = self.m
         if self.xyz is not None and all(
             _num(a) == _num(b) for a, b in zip(xyz, self.xyz, strict=True)
         ):
             return
-        f = f" F{_feed(m.travel_feed * m.feed_scale)}" if m.dialect == "marlin" else ""
-        self.emit(f"G0 {self._words(xyz, None, axes)}{f}")
+        if m.dialect == "aerotech":
+            if self.feed != m.travel_feed:
+                self.emit(f"G1 F{_feed(m.travel_feed)}")
+                self.feed = m.travel_feed
+            self.emit(f"G1 {self._words(xyz, None, axes)}")
+        else:
+            f = f" F{_feed(m.travel_feed * m.feed_scale)}" if m.dialect == "marlin" else ""
+            self.emit(f"G0 {self._words(xyz, None, axes)}{f}")
         if self.xyz is not None:
             distance = float(np.linalg.norm(xyz - self.xyz))
             self.time += distance / m.travel_feed if math.isfinite(distance) else 0.0
         self.xyz = xyz.copy()
+
+    def pressure(self, port: int, psi: float, on: bool) -> None:
+        """Pressure lines of one channel; serial calls cost the profile's pressure_call_s."""
+        lines = pressure_lines(self.m, port, psi, on)
+        self.emit(*lines)
+        self.time += self.m.pressure_call_s * sum(ln.startswith("Call ") for ln in lines)
 
     def linear(self, xyz: np.ndarray, angle: float, speed: float, axes: str) -> None:
         """A feed move with the rotary word; F on its own line (aerotech) or in the block."""
@@ -309,6 +348,8 @@ class _Writer:
         self.feed = speed
         assert self.xyz is not None
         self.time += math.dist(xyz, self.xyz) / speed
+        self.turned += abs(angle - self.angle)
+        self.wound = max(self.wound, abs(angle + self.shift))
         self.xyz, self.angle = xyz.copy(), angle
 
 
@@ -406,7 +447,15 @@ def _travel_height(m: MachineProfile, top: float, *zs: float) -> float:
 
 
 def _header(
-    m: MachineProfile, n: int, layers: int, design_hash: str, total: float, order: str
+    m: MachineProfile,
+    n: int,
+    layers: int,
+    design_hash: str,
+    total: float,
+    order: str,
+    turns: list[float],
+    w: _Writer,
+    placeholders: dict[str, set[float]],
 ) -> list[str]:
     if m.is_builtin:
         origin = (
@@ -423,11 +472,25 @@ def _header(
         if m.rotary_rebase == "g92"
         else f"unwound while lowering to each filament, |{m.rotary_axis}| <= {turn}"
     )
-    return [
+    k_max = int(np.argmax(np.abs(turns)))
+    wound = w.wound / m.turn
+    if m.continuous_rotation:
+        said = "the built-in default assumes" if m.is_builtin else "the profile says it has"
+        hoses = (
+            f"the nozzle winds up to {wound:.1f} turns: {said} a rotary union "
+            "(continuous_rotation = true)"
+        )
+    else:
+        hoses = (
+            f"no rotary union (continuous_rotation = false): unwound on every travel, at most "
+            f"{wound:.1f} turns wound, limit {m.max_turns:g} per filament (max_turns)"
+        )
+    lines = [
         "; rotomorph G-code (rotational multimaterial printing)",
         f"; tool: rotomorph {rotomorph.__version__}",
         f"; design-sha256: {design_hash}",
         f"; machine: {m.name}, {origin}",
+        f"; controller: {m.controller}",
         f"; limits: envelope {list(m.envelope_min)}..{list(m.envelope_max)} mm, feed "
         f"{m.min_feed:g}..{m.max_feed:g} mm/s, rotation <= {m.max_rotation:g} rad/s (travel "
         f"included), pressure {m.min_pressure:g}..{m.max_pressure:g} psi, lift {m.lift:g} mm",
@@ -437,12 +500,35 @@ def _header(
         f"; axes: {m.x_axis}=x {m.y_axis}=y {m.z_axis}=z (design z + z_offset {m.z_offset:g} "
         "mm; Z 0 = substrate surface in the active work offset)",
         f"; rotary: {m.rotary_axis} = nozzle angle of the active half, counter-clockwise from +x "
-        f"seen from above times sign {m.rotary_sign:+d}; must read 0 with the active half toward "
-        f"+x at the start; cumulative within a filament, {rebase}",
+        f"seen from above times sign {m.rotary_sign:+d}",
+        f";   must read 0 with the active half toward +x at the start; cumulative within a "
+        f"filament, {rebase}",
+        f"; nozzle turns (physical): up to {abs(turns[k_max]):.1f} in one filament (filament "
+        f"{k_max}), {w.turned / m.turn:.1f} turned in all (travel included)",
+        f";   {hoses}",
         f"; pressure channels: active port {m.active_port}, passive port {m.passive_port}",
         f"; filaments: {n}, layers: {layers}, order: {order}",
         f"; estimated print time: {total:.1f} s",
     ]
+    if placeholders:
+        units = {"active_pressure": "psi", "passive_pressure": "psi"}
+        said = ", ".join(
+            f"{k} {'/'.join(f'{v:g}' for v in sorted(vals))} {units.get(k, 's')}"
+            for k, vals in placeholders.items()
+        )
+        lines += [
+            f"; PLACEHOLDER values (defaults, not set by the design): {said}",
+            ";   set them in the design's [nozzle] table (or per filament) before printing",
+        ]
+    return lines
+
+
+def placeholder_settings(process: Process | Sequence[Process] | None) -> list[str]:
+    """Names of the process settings that are placeholders in ``process`` (None: all)."""
+    if process is None:
+        return list(PLACEHOLDER_SETTINGS)
+    procs = [process] if isinstance(process, Process) else list(process)
+    return [k for k in PLACEHOLDER_SETTINGS if any(k in p.placeholders for p in procs)]
 
 
 def plan_programs(
@@ -476,9 +562,11 @@ def gcode_text(
         The printer: limits, axes, dialect, pressure idiom.
     process
         Pressures and dwells, one :class:`Process` for all or one per program (default
-        :class:`Process`: 30 psi on each channel used, no dwells).
+        :class:`Process`: 30 psi on each channel used, no dwells, all flagged as placeholders
+        in the header).
     layer_cure_s
-        UV-cure dwell after each layer (s); 0 writes none.
+        UV cure after each layer (s): a dwell between the profile's lamp commands, or a pause
+        for the operator where the profile has none; 0 writes none.
     design_hash
         sha256 to record in the header; default :func:`programs_sha256` of ``programs``.
     serpentine
@@ -505,20 +593,41 @@ def gcode_text(
     if design_hash is not None and not re.fullmatch(r"[0-9a-f]{64}", design_hash):
         raise InvalidParameterError("design_hash", "must be a sha256 hex digest (64 characters)")
     check_materials(programs)
-    procs = _as_process(Process() if process is None else process, len(programs))
+    if process is None:
+        process = Process(placeholders=PLACEHOLDER_SETTINGS)
+    procs = _as_process(process, len(programs))
     m = machine
     printed = plan_programs(programs, m, serpentine=serpentine)
+    placeholders: dict[str, set[float]] = {}
     for k, (prog, proc) in enumerate(zip(printed, procs, strict=True)):
         _check_process(k, prog, proc, m)
+        used = {f"{role}_pressure" for role, _ in proc.channels(prog.active_fraction)}
+        for name in proc.placeholders:
+            if name in used or name.endswith("_dwell"):
+                placeholders.setdefault(name, set()).add(float(getattr(proc, name)))
 
     w = _Writer(m)
     top = -math.inf
     current_layer: int | None = None
+    turns: list[float] = []
+    w.emit("; every pressure channel off before the first move (explicit states)")
+    for port in (m.active_port, m.passive_port):
+        w.pressure(port, 0.0, False)
     for k, (prog, proc) in enumerate(zip(printed, procs, strict=True)):
         pts = np.round(prog.points, _DIGITS)
         start = _start_word(w, prog, m)
         words = _written_angles(prog, pts, start, m.rotary_scale)
         _check_program(k, prog, pts, words, m)
+        turns.append(float(words[-1] - words[0]) / m.turn)
+        if not m.continuous_rotation and abs(turns[-1]) > m.max_turns * (1 + 1e-12):
+            raise _limit(
+                f"program {k}",
+                f"the nozzle turns {abs(turns[-1]):.1f} times within this one filament, more "
+                f"than the {m.max_turns:g} turns its hoses allow without a rotary union",
+                "max_turns",
+                "lower the design's rotation, set continuous_rotation = true if the machine has "
+                "a rotary union, or raise",
+            )
         zt = _travel_height(m, top, pts[0, 2], *([] if w.xyz is None else [w.xyz[2]]))
         if prog.layer != current_layer:
             if current_layer is not None and layer_cure_s > 0:
@@ -529,17 +638,18 @@ def gcode_text(
         w.emit(
             f"; filament {k} layer={prog.layer} radius={prog.radius!r} "
             f"active_fraction={prog.active_fraction!r} active_material={prog.active_material} "
-            f"passive_material={prog.passive_material}"
+            f"passive_material={prog.passive_material}",
+            f"; filament {k} turns the nozzle {turns[-1]:+.2f} times",
         )
         _travel(w, k, pts[0], zt, start)
         for role, psi in proc.channels(prog.active_fraction):
-            w.emit(*pressure_lines(m, getattr(m, f"{role}_port"), psi, True))
+            w.pressure(getattr(m, f"{role}_port"), psi, True)
         w.dwell(proc.prime_dwell)
         for i in range(1, len(pts)):
             axes = "xyz" if _num(pts[i, 2]) != _num(pts[i - 1, 2]) else "xy"
             w.linear(pts[i], float(words[i]), float(prog.speed[i - 1]), axes)
         for role, psi in proc.channels(prog.active_fraction):
-            w.emit(*pressure_lines(m, getattr(m, f"{role}_port"), psi, False))
+            w.pressure(getattr(m, f"{role}_port"), psi, False)
         w.dwell(proc.release_dwell)
         w.emit(f"; end filament {k}")
         top = max(top, float(pts[:, 2].max()))
@@ -549,7 +659,7 @@ def gcode_text(
         _cure(w, current_layer, layer_cure_s)
     if w.shift != 0.0:
         w.emit(f"G92 {m.rotary_axis}{_num(w.angle + w.shift)}")
-    w.emit(*(m.end_lines or ()), *m.footer_lines)
+    w.emit(*(m.end_lines or ()), *gcode_aerotech.subroutines(m), *m.footer_lines)
     order = "serpentine" if serpentine else "as designed"
     head = _header(
         m,
@@ -558,10 +668,21 @@ def gcode_text(
         design_hash or programs_sha256(programs),
         w.time,
         order,
+        turns,
+        w,
+        placeholders,
     )
-    text = "\n".join([*head, *m.header_lines, *(m.setup_lines or ()), *w.lines]) + "\n"
+    body = [*gcode_aerotech.declarations(m), *m.header_lines, *(m.setup_lines or ()), *w.lines]
+    text = "\n".join([*head, *body]) + "\n"
     if re.search(r"[^\x20-\x7e\n]", text):  # pragma: no cover - every input is checked
         raise AssertionError("non-printable character in the program")
+    for no, line in enumerate(text.splitlines(), 1):
+        if len(line) > MAX_LINE:
+            raise InvalidParameterError(
+                "machine profile",
+                f"line {no} of the program would be {len(line)} characters, over {MAX_LINE} "
+                f"(LinuxCNC refuses lines over 252); shorten the profile's text: {line[:40]!r}...",
+            )
     return text
 
 
@@ -606,18 +727,22 @@ def _travel(w: _Writer, k: int, start: np.ndarray, zt: float, angle: float) -> N
 
 
 def _cure(w: _Writer, layer: int | None, seconds: float) -> None:
+    """UV cure after a layer: lamp on, dwell, lamp off with the profile's lamp commands, else a
+    real pause (the controller waits for the operator, who cures by hand and resumes)."""
     m = w.m
-    manual = (
-        ""
-        if m.uv_on_template
-        else " (no UV command in the machine profile: switch the lamp by hand)"
-    )
-    w.emit(f"; UV cure after layer {layer}: {seconds:g} s{manual}")
     if m.uv_on_template:
-        w.emit(m.uv_on_template)
-    w.dwell(seconds)
-    if m.uv_off_template:
-        w.emit(m.uv_off_template)
+        w.emit(f"; UV cure after layer {layer}: {seconds:g} s", m.uv_on_template)
+        w.dwell(seconds)
+        if m.uv_off_template:
+            w.emit(m.uv_off_template)
+        return
+    w.emit(
+        f"; UV cure after layer {layer}: {seconds:g} s by hand (no lamp commands in the machine "
+        f"profile): the program pauses ({m.pause_template}); switch the lamp on for "
+        f"{seconds:g} s, off, then resume",
+        m.pause_template or "",
+    )
+    w.time += seconds  # the operator's cure, counted in the estimate
 
 
 def write_gcode(

@@ -26,6 +26,7 @@ import numpy as np
 
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import GcodeParseError, InvalidParameterError, MachineLimitError
+from rotomorph.io import gcode_aerotech
 from rotomorph.io.machine import MachineProfile
 
 __all__ = ["GcodeReport", "ReadFilament", "check_gcode", "parse_gcode", "read_gcode"]
@@ -35,6 +36,7 @@ _META = re.compile(
     r"; filament (\d+) layer=(\d+) radius=(\S+) active_fraction=(\S+) "
     r"active_material=(\S+) passive_material=(\S+)$"
 )
+_CURE = re.compile(rf"; UV cure after layer \d+: ({_NUM}) s by hand")
 _TOL = 1e-6  # relative tolerance of limit checks on read-back numbers
 
 
@@ -177,6 +179,8 @@ class _Reader:
     # ------------------------------------------------------------------ commands
     def pressure(self, no: int, line: str) -> bool:
         m = self.m
+        if line.startswith("Call "):  # a serial call takes time (profile key pressure_call_s)
+            self.s.time += m.pressure_call_s
         if m.pressure_idiom == "alicat":
             pm = re.fullmatch(rf"Call setAlicatPress P(\d+) Q({_NUM})", line)
             if pm:
@@ -192,8 +196,12 @@ class _Reader:
                     raise self.fail(no, "set-point changed while dispensing", line)
                 self.set_pressure(no, line, port, float(pm[2]), False)
                 return True
+            pm = re.fullmatch(r"Call setDispense P(\d+) Q([01])", line)
+            if pm:  # rotomorph's explicit state
+                self.switch(no, line, self.port(no, line, pm[1]), pm[2] == "1")
+                return True
             pm = re.fullmatch(r"Call togglePress P(\d+)", line)
-            if pm:
+            if pm:  # mecode's toggle (read, never written: it depends on the dispenser's state)
                 port = self.port(no, line, pm[1])
                 self.switch(no, line, port, not self.s.on.get(port, False))
             return pm is not None
@@ -243,6 +251,14 @@ class _Reader:
             raise self.fail(no, "block without motion", line)
         self.envelope(no, new)
         s.moves += 1
+        travel = cmd == "G1" and m.dialect == "aerotech" and not s.printing and not moved[3]
+        if travel and feed is None and s.feed is not None:  # mecode's travel: G1 at travel feed
+            if s.feed > max(m.max_feed, m.travel_feed) * (1 + _TOL):
+                raise self.limit(no, f"travel feed {s.feed:g} mm/s above the maximum", "travel_feed")
+            distance = math.dist(new[:3], s.pos[:3])
+            s.time += distance / s.feed if math.isfinite(distance) else 0.0
+            s.pos = new
+            return
         if cmd == "G0":
             if moved[3]:
                 raise self.fail(
@@ -362,14 +378,18 @@ class _Reader:
             elif s.current is not None:
                 raise self.fail(no, "dwell in the middle of a filament", line)
             return True
-        if line in self.uv:
+        if line in self.uv or line == m.pause_template:
             if s.printing:
-                raise self.fail(no, "UV line with a pressure on", line)
+                raise self.fail(no, "UV line or pause with a pressure on", line)
             return True
         gm = re.fullmatch(rf"G92 {m.rotary_axis}({_NUM})", line)
         if gm:
             if s.printing:
                 raise self.fail(no, "G92 with a pressure on", line)
+            if m.controller == "klipper":
+                raise self.fail(
+                    no, "G92 with a rotary word on Klipper (its G92 would zero X, Y and Z)", line
+                )
             s.pos[3] = float(gm[1])
             return True
         return False
@@ -407,7 +427,10 @@ class _Reader:
     def _read(self, lines: list[str], first: int) -> GcodeReport:
         m, s = self.m, self.s
         i = first
-        header = list(m.header_lines)
+        # rotomorph's own programs carry their subroutines; a lab's (mecode) program may not
+        ours = bool(lines) and lines[0].startswith("; rotomorph G-code")
+        library = ours or any(ln.startswith("DVAR ") for ln in lines[:first + 2])
+        header = [*(gcode_aerotech.declarations(m) if library else ()), *m.header_lines]
         for start in range(first, -1, -1):  # the header block may itself open with comments
             if lines[start : start + len(header)] == header:
                 i = start + len(header)
@@ -420,11 +443,15 @@ class _Reader:
             raise self.fail(i + 1, f"expected the profile's setup_lines {setup}", str(got))
         i += len(setup)
         end = len(lines)
-        if m.footer_lines:
-            got = lines[end - len(m.footer_lines) :]
-            if got != list(m.footer_lines):
-                raise self.fail(end, "the profile's footer_lines are missing", "<end of file>")
-            end -= len(m.footer_lines)
+        footer = [*(gcode_aerotech.subroutines(m) if library else ()), *m.footer_lines]
+        if footer:
+            got = lines[end - len(footer) :]
+            if got != footer:
+                what = "footer_lines" if got[-len(m.footer_lines) or len(got) :] != list(
+                    m.footer_lines
+                ) else "pressure subroutines"
+                raise self.fail(end, f"the profile's {what} are missing", "<end of file>")
+            end -= len(footer)
         tail = [k for k in range(i, end) if lines[k].strip() and not lines[k].startswith(";")]
         n_end = len(end_lines)
         if [lines[k].strip() for k in tail[len(tail) - n_end :]] != end_lines or (
@@ -437,6 +464,9 @@ class _Reader:
             if not line:
                 continue
             if line.startswith(";"):
+                cure = _CURE.match(line)
+                if cure:  # the operator's cure at a pause, as the writer counts it
+                    s.time += float(cure[1])
                 mm = _META.match(line)
                 if mm:
                     if s.current is not None or s.meta is not None:

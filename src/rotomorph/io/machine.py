@@ -56,7 +56,25 @@ __all__ = [
 
 DIALECTS = ("aerotech", "rs274", "marlin")
 PRESSURE_IDIOMS = ("alicat", "nordson", "template")
+#: Controllers of each dialect (the first is the dialect's default); the controller decides the
+#: generated controller-side configuration, the pause command and what G92 may carry.
+CONTROLLERS: dict[str, tuple[str, ...]] = {
+    "aerotech": ("a3200",),
+    "rs274": ("linuxcnc",),
+    "marlin": ("marlin", "klipper", "reprapfirmware"),
+}
+#: A real pause (waits for the operator) per controller, for a cure without lamp commands.
+_PAUSE = {
+    "a3200": "M0",
+    "linuxcnc": "M0",
+    "marlin": "M0",
+    "klipper": "PAUSE",
+    "reprapfirmware": "M226",
+}
 BUILTIN = "built-in default"
+#: Time (s) one serial pressure call of an Aerotech subroutine takes (a Nordson togglePress was
+#: measured at 0.15 s); counted in the time estimate unless the profile sets pressure_call_s.
+SERIAL_CALL_S = 0.15
 
 #: Dialect defaults of the keys left unset (``None``) in a profile.
 _DEFAULTS: dict[str, dict[str, Any]] = {
@@ -66,7 +84,8 @@ _DEFAULTS: dict[str, dict[str, Any]] = {
         "valve_on_template": "",
         "valve_off_template": "",
         "dwell_template": "G4 P{s}",
-        "setup_lines": ("G71", "G76", "G90"),
+        # metric, seconds, absolute, velocity blending between moves (no stop at each vertex)
+        "setup_lines": ("G71", "G76", "G90", "VELOCITY ON"),
         "end_lines": ("M2",),
     },
     "rs274": {
@@ -86,6 +105,14 @@ _DEFAULTS: dict[str, dict[str, Any]] = {
         "dwell_template": "G4 P{ms}",
         "setup_lines": ("G21", "G90"),
         "end_lines": (),
+    },
+}
+#: Controller defaults over the dialect's (Klipper: the generated printer.cfg's macros).
+_CONTROLLER_DEFAULTS: dict[str, dict[str, Any]] = {
+    "klipper": {
+        "pressure_template": "SET_PIN PIN=pressure{port} VALUE={fraction:.4f}",
+        "setup_lines": ("ROTOMORPH_START", "G21", "G90"),
+        "end_lines": ("ROTOMORPH_END",),
     },
 }
 _PRESSURE_FIELDS = {"psi", "fraction", "pwm"}
@@ -216,7 +243,10 @@ class MachineProfile:
     rotary_axis: str = "C"
     rotary_units: str = "deg"
     rotary_sign: int = 1
-    rotary_rebase: str = "g92"
+    rotary_rebase: str | None = None
+    continuous_rotation: bool = True
+    max_turns: float = 10.0
+    controller: str | None = None
     lift: float = 2.0
     z_offset: float = 0.0
     pressure_idiom: str | None = None
@@ -226,6 +256,8 @@ class MachineProfile:
     dwell_template: str | None = None
     uv_on_template: str = ""
     uv_off_template: str = ""
+    pause_template: str | None = None
+    pressure_call_s: float | None = None
     setup_lines: tuple[str, ...] | None = None
     end_lines: tuple[str, ...] | None = None
     header_lines: tuple[str, ...] = ()
@@ -237,12 +269,53 @@ class MachineProfile:
         check_line("machine profile source", self.source)
         if self.dialect not in DIALECTS:
             raise _bad("dialect", f"must be one of {DIALECTS}; got {self.dialect!r}")
-        for key, value in _DEFAULTS[self.dialect].items():
+        controller = self.controller or CONTROLLERS[self.dialect][0]
+        defaults = {**_DEFAULTS[self.dialect], **_CONTROLLER_DEFAULTS.get(controller, {})}
+        for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
+        self._check_controller()
         self._check_numbers()
         self._check_axes()
         self._check_text()
+
+    def _check_controller(self) -> None:
+        allowed = CONTROLLERS[self.dialect]
+        if self.controller is None:
+            object.__setattr__(self, "controller", allowed[0])
+        if self.controller not in allowed:
+            raise _bad(
+                "controller",
+                f"must be one of {allowed} for the {self.dialect!r} dialect; got {self.controller!r}",
+            )
+        if not isinstance(self.continuous_rotation, bool):
+            raise _bad("continuous_rotation", f"must be true or false; got {self.continuous_rotation!r}")
+        v = self.max_turns
+        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
+            raise _bad("max_turns", f"must be a number of turns > 0; got {v!r}")
+        if self.rotary_rebase is None:
+            g92 = self.continuous_rotation and self.controller != "klipper"
+            object.__setattr__(self, "rotary_rebase", "g92" if g92 else "unwind")
+        if self.rotary_rebase == "g92" and self.controller == "klipper":
+            raise _bad(
+                "rotary_rebase",
+                "Klipper's G92 sets X, Y, Z and E only (a 'G92 C...' zeroes X, Y and Z); "
+                "use 'unwind' on Klipper",
+            )
+        if self.rotary_rebase == "g92" and not self.continuous_rotation:
+            raise _bad(
+                "rotary_rebase",
+                "'g92' re-bases the angle word but leaves the nozzle's hoses wound; it needs a "
+                "rotary union (continuous_rotation = true), else use 'unwind'",
+            )
+        if self.pause_template is None:
+            object.__setattr__(self, "pause_template", _PAUSE[self.controller])
+        if self.pressure_call_s is None:
+            serial = self.pressure_idiom in ("alicat", "nordson")
+            object.__setattr__(self, "pressure_call_s", SERIAL_CALL_S if serial else 0.0)
+        v = self.pressure_call_s
+        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v >= 0):
+            raise _bad("pressure_call_s", f"must be a time in s >= 0; got {v!r}")
 
     def _check_numbers(self) -> None:
         try:
@@ -306,6 +379,7 @@ class MachineProfile:
             "dwell_template": {"s", "ms"},
             "uv_on_template": set(),
             "uv_off_template": set(),
+            "pause_template": set(),
         }
         sample = {"port": 5, "psi": 1.5, "fraction": 0.5, "pwm": 128, "s": 1.5, "ms": 1500}
         for key, allowed in templates.items():
@@ -397,7 +471,10 @@ class MachineProfile:
             raise _bad(unknown[0], f"unknown setting; known: {sorted(known)}")
         for k, v in data.items():
             default = getattr(cls, k, None)
-            if k in ("envelope_min", "envelope_max"):
+            if k == "continuous_rotation":
+                if not isinstance(v, bool):
+                    raise _bad(k, f"must be true or false; got {v!r}")
+            elif k in ("envelope_min", "envelope_max"):
                 if not isinstance(v, list | tuple) or not all(
                     isinstance(c, int | float) and not isinstance(c, bool) for c in v
                 ):
@@ -407,7 +484,7 @@ class MachineProfile:
                 if not isinstance(v, list | tuple) or not all(isinstance(c, str) for c in v):
                     raise _bad(k, f"must be a list of strings; got {v!r}")
                 data[k] = tuple(v)
-            elif k.endswith(("_template", "_idiom")) or isinstance(default, str):
+            elif k.endswith(("_template", "_idiom")) or k in ("controller", "rotary_rebase") or isinstance(default, str):
                 if not isinstance(v, str):
                     raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r}")
             elif isinstance(v, bool) or not isinstance(v, int | float):
@@ -440,5 +517,7 @@ def load_machine_profile(path: str | FilePath) -> MachineProfile:
     table = data.get("machine", data)
     if not isinstance(table, dict):
         raise _bad("machine", f"must be a table [machine]; got {table!r}")
+    # a profile file states whether the machine has a rotary union; unsaid, it has none
+    table = {"continuous_rotation": False, **table}
     profile = MachineProfile.from_dict(table, folder=path.parent)
     return replace(profile, source=check_line("machine profile path", path.name))
