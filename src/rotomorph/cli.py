@@ -308,8 +308,10 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     from rotomorph.io.gcode_read import check_gcode
 
     if args.check is not None:
-        if args.design is not None or args.output is not None or args.preview:
-            raise UsageError("--check FILE takes only --machine (no DESIGN, -o or --preview)")
+        if args.design is not None or args.output is not None or args.preview or args.machine_config:
+            raise UsageError(
+                "--check FILE takes only --machine (no DESIGN, -o, --preview or --machine-config)"
+            )
         if args.machine is None:
             raise UsageError("--check FILE needs --machine PROFILE.toml to check against")
         path = _existing_file(args.check, "--check")
@@ -333,14 +335,34 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     machine = _machine(args)
     programs = design.to_programs()
     _check_materials(programs)
-    write_gcode(programs, out, machine, **design.gcode_options(), layer_cure_s=args.cure)
+    options = design.gcode_options()
+    write_gcode(programs, out, machine, **options, layer_cure_s=args.cure)
     _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
+    _gcode_extras(args, out, machine, options)
     if args.preview:
         from rotomorph.plot.toolpath import save_toolpath_png
 
         png = save_toolpath_png(plan_programs(programs, machine), out.with_suffix(".png"))
         _print(f"wrote {png}")
     return EXIT_OK
+
+
+def _gcode_extras(args: argparse.Namespace, out: Path, machine: Any, options: Any) -> None:
+    """Placeholder warning and the controller configuration of ``gcode`` (after the program)."""
+    from rotomorph.io.gcode import placeholder_settings
+
+    unset = placeholder_settings(options["process"])
+    if unset:
+        sys.stderr.write(
+            f"rotomorph: warning: placeholder process values (not set by the design): "
+            f"{', '.join(unset)}; set them in its [nozzle] table (flagged in {out}'s header)\n"
+        )
+    if args.machine_config is not None:
+        from rotomorph.io.machine_config import write_machine_config
+
+        text = out.read_text(encoding="ascii")
+        for path in write_machine_config(machine, text, args.machine_config):
+            _print(f"wrote {path}")
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
@@ -517,6 +539,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cure", type=float, default=0.0, metavar="S", help="UV dwell per layer (s)")
     p.add_argument("--preview", action="store_true", help="also write FILE.png (toolpath)")
     p.add_argument("--check", metavar="FILE", help="check an existing program instead")
+    p.add_argument(
+        "--machine-config",
+        metavar="DIR",
+        help="also write the controller-side configuration the program needs into DIR",
+    )
     p.set_defaults(func=_cmd_gcode)
 
     p = sub.add_parser(
