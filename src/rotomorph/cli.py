@@ -308,7 +308,12 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     from rotomorph.io.gcode_read import check_gcode
 
     if args.check is not None:
-        if args.design is not None or args.output is not None or args.preview or args.machine_config:
+        if (
+            args.design is not None
+            or args.output is not None
+            or args.preview
+            or args.machine_config
+        ):
             raise UsageError(
                 "--check FILE takes only --machine (no DESIGN, -o, --preview or --machine-config)"
             )

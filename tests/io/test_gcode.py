@@ -303,9 +303,9 @@ def test_machine_profile(tmp_path):
         MachineProfile(dialect="klipper")  # Klipper is a controller of the marlin dialect
     with pytest.raises(InvalidParameterError, match="'controller'"):
         MachineProfile(dialect="rs274", controller="klipper")
-    with pytest.raises(InvalidParameterError, match="'rotary_rebase'.*Klipper"):
+    with pytest.raises(InvalidParameterError, match=r"'rotary_rebase'.*Klipper"):
         MachineProfile(dialect="marlin", controller="klipper", rotary_rebase="g92")
-    with pytest.raises(InvalidParameterError, match="'rotary_rebase'.*rotary union"):
+    with pytest.raises(InvalidParameterError, match=r"'rotary_rebase'.*rotary union"):
         MachineProfile(continuous_rotation=False, rotary_rebase="g92")
     assert MachineProfile(dialect="marlin", controller="klipper").rotary_rebase == "unwind"
     assert MachineProfile(continuous_rotation=False).rotary_rebase == "unwind"

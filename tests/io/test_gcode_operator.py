@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
 from rotomorph.io.designfile import load_design
-from dataclasses import replace
-
 from rotomorph.io.gcode import gcode_text
 from rotomorph.io.machine import MachineProfile, load_machine_profile
 

@@ -64,9 +64,22 @@ def _run(rs274: str, folder: Path, program: str, ini_files: dict[str, str]) -> l
         (folder / name).write_text(text)
     (folder / "p.ngc").write_text(program)
     done = subprocess.run(
-        [rs274, "-g", "-i", "rotomorph.ini", "-t", "tool.tbl", "-v", "rotomorph.var", "p.ngc",
-         "out.canon"],
-        cwd=folder, capture_output=True, text=True, timeout=120,
+        [
+            rs274,
+            "-g",
+            "-i",
+            "rotomorph.ini",
+            "-t",
+            "tool.tbl",
+            "-v",
+            "rotomorph.var",
+            "p.ngc",
+            "out.canon",
+        ],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     noise = [ln for ln in (done.stdout + done.stderr).splitlines() if ln.strip() != "executing"]
     assert done.returncode == 0 and not noise, (done.returncode, noise[:5])
@@ -118,8 +131,13 @@ def test_rs274_runs_every_program_as_designed(rs274, tmp_path, name):
                 assert not on, "a rapid move with a channel open"
             if on:
                 if current is None:
-                    current = {"pts": [pos[:3]], "c": [pos[3]], "feed": [], "on": dict(valve),
-                               "psi": dict(setpoint)}
+                    current = {
+                        "pts": [pos[:3]],
+                        "c": [pos[3]],
+                        "feed": [],
+                        "on": dict(valve),
+                        "psi": dict(setpoint),
+                    }
                     filaments.append(current)
                 current["pts"].append((x, y, z))
                 current["c"].append(c)
@@ -170,7 +188,7 @@ def test_an_aborted_program_leaves_every_channel_off(rs274, tmp_path, name):
     for k, cut in enumerate(cuts):
         folder = tmp_path / f"cut{k}"
         folder.mkdir()
-        program = "\n".join(lines[:cut] + [f"O <{ABORT_SUBROUTINE}> call", "M2"]) + "\n"
+        program = "\n".join([*lines[:cut], f"O <{ABORT_SUBROUTINE}> call", "M2"]) + "\n"
         calls = _run(rs274, folder, program, files)
         valve = {}
         value = {}

@@ -61,9 +61,9 @@ __all__ = [
     "MAX_LINE",
     "PLACEHOLDER_SETTINGS",
     "Process",
-    "placeholder_settings",
     "check_materials",
     "gcode_text",
+    "placeholder_settings",
     "pressure_lines",
     "programs_sha256",
     "write_gcode",
@@ -126,7 +126,8 @@ class Process:
         unknown = set(self.placeholders) - set(PLACEHOLDER_SETTINGS)
         if unknown:
             raise InvalidParameterError(
-                "Process.placeholders", f"must name settings of {PLACEHOLDER_SETTINGS}; got {sorted(unknown)}"
+                "Process.placeholders",
+                f"must name settings of {PLACEHOLDER_SETTINGS}; got {sorted(unknown)}",
             )
         for name in ("active_pressure", "passive_pressure", "prime_dwell", "release_dwell"):
             v = getattr(self, name)

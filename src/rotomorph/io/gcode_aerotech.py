@@ -21,8 +21,8 @@ their serial ports; ``P`` is the COM port and ``Q`` the value, as in mecode's ca
     with a dispenser running (the globals then read 0; docs/gcode.md says what to check).
 
 Each subroutine opens the port, writes and closes it (no nested calls, so ``$P`` and ``$Q`` are
-the caller's). Frames of the Ultimus protocol: ENQ, then STX, two digits of length, the command and its data,
-a two-digit hex checksum (the two's complement of the byte sum), ETX; then EOT.
+the caller's). Frames of the Ultimus protocol: ENQ, then STX, two digits of length, the command
+and its data, a two-digit hex checksum (the two's complement of the byte sum), ETX; then EOT.
 """
 
 from __future__ import annotations
@@ -43,11 +43,10 @@ CALLS: dict[str, tuple[str, ...]] = {
 _VARIABLES = {"alicat": ("$hFile",), "nordson": ("$hFile", "$sum", "$k", "$frame", "$hex")}
 
 _OPEN = (
-    "    $hFile = FILEOPEN \"COM\" + DBLTOSTR($P, 0), 2",
+    '    $hFile = FILEOPEN "COM" + DBLTOSTR($P, 0), 2',
     '    COMMINIT $hFile, "baud=115200 parity=N data=8 stop=1"',
     "    COMMSETTIMEOUT $hFile, -1, -1, 1000",
 )
-
 
 
 def _nordson_frame(command: str) -> list[str]:
@@ -76,8 +75,10 @@ def declarations(m: MachineProfile) -> list[str]:
     """The ``DVAR`` line the profile's pressure subroutines need (none for templates)."""
     if m.dialect != "aerotech" or m.pressure_idiom not in CALLS:
         return []
-    return ["; rotomorph: variables of the pressure subroutines at the end of this program",
-            "DVAR " + " ".join(_VARIABLES[m.pressure_idiom])]
+    return [
+        "; rotomorph: variables of the pressure subroutines at the end of this program",
+        "DVAR " + " ".join(_VARIABLES[m.pressure_idiom]),
+    ]
 
 
 def subroutines(m: MachineProfile) -> list[str]:
@@ -89,14 +90,16 @@ def subroutines(m: MachineProfile) -> list[str]:
         "; settings 115200 baud 8N1: change them here if your regulators differ",
     ]
     if m.pressure_idiom == "alicat":
-        return head + [
+        return [
+            *head,
             "DFS setAlicatPress",
             *_OPEN,
             '    FILEWRITE $hFile "AS" + DBLTOSTR($Q, 3) + "\\r"',
             "    FILECLOSE $hFile",
             "ENDDFS",
         ]
-    return head + [
+    return [
+        *head,
         "; rotomorph: pressure set-point in psi (the Ultimus takes tenths of a psi, 4 digits)",
         "DFS setPress",
         "    $k = ROUND($Q * 10)",

@@ -254,7 +254,9 @@ class _Reader:
         travel = cmd == "G1" and m.dialect == "aerotech" and not s.printing and not moved[3]
         if travel and feed is None and s.feed is not None:  # mecode's travel: G1 at travel feed
             if s.feed > max(m.max_feed, m.travel_feed) * (1 + _TOL):
-                raise self.limit(no, f"travel feed {s.feed:g} mm/s above the maximum", "travel_feed")
+                raise self.limit(
+                    no, f"travel feed {s.feed:g} mm/s above the maximum", "travel_feed"
+                )
             distance = math.dist(new[:3], s.pos[:3])
             s.time += distance / s.feed if math.isfinite(distance) else 0.0
             s.pos = new
@@ -429,7 +431,7 @@ class _Reader:
         i = first
         # rotomorph's own programs carry their subroutines; a lab's (mecode) program may not
         ours = bool(lines) and lines[0].startswith("; rotomorph G-code")
-        library = ours or any(ln.startswith("DVAR ") for ln in lines[:first + 2])
+        library = ours or any(ln.startswith("DVAR ") for ln in lines[: first + 2])
         header = [*(gcode_aerotech.declarations(m) if library else ()), *m.header_lines]
         for start in range(first, -1, -1):  # the header block may itself open with comments
             if lines[start : start + len(header)] == header:
@@ -447,9 +449,11 @@ class _Reader:
         if footer:
             got = lines[end - len(footer) :]
             if got != footer:
-                what = "footer_lines" if got[-len(m.footer_lines) or len(got) :] != list(
-                    m.footer_lines
-                ) else "pressure subroutines"
+                what = (
+                    "footer_lines"
+                    if got[-len(m.footer_lines) or len(got) :] != list(m.footer_lines)
+                    else "pressure subroutines"
+                )
                 raise self.fail(end, f"the profile's {what} are missing", "<end of file>")
             end -= len(footer)
         tail = [k for k in range(i, end) if lines[k].strip() and not lines[k].startswith(";")]

@@ -257,7 +257,7 @@ class MachineProfile:
     uv_on_template: str = ""
     uv_off_template: str = ""
     pause_template: str | None = None
-    pressure_call_s: float | None = None
+    pressure_call_s: float = math.nan  # NaN: the idiom's default (SERIAL_CALL_S or 0)
     setup_lines: tuple[str, ...] | None = None
     end_lines: tuple[str, ...] | None = None
     header_lines: tuple[str, ...] = ()
@@ -286,12 +286,19 @@ class MachineProfile:
         if self.controller not in allowed:
             raise _bad(
                 "controller",
-                f"must be one of {allowed} for the {self.dialect!r} dialect; got {self.controller!r}",
+                f"must be one of {allowed} for the {self.dialect!r} dialect; "
+                f"got {self.controller!r}",
             )
         if not isinstance(self.continuous_rotation, bool):
-            raise _bad("continuous_rotation", f"must be true or false; got {self.continuous_rotation!r}")
+            raise _bad(
+                "continuous_rotation", f"must be true or false; got {self.continuous_rotation!r}"
+            )
         v = self.max_turns
-        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v > 0):
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, int | float)
+            or not (math.isfinite(v) and v > 0)
+        ):
             raise _bad("max_turns", f"must be a number of turns > 0; got {v!r}")
         if self.rotary_rebase is None:
             g92 = self.continuous_rotation and self.controller != "klipper"
@@ -310,11 +317,15 @@ class MachineProfile:
             )
         if self.pause_template is None:
             object.__setattr__(self, "pause_template", _PAUSE[self.controller])
-        if self.pressure_call_s is None:
+        if isinstance(self.pressure_call_s, float) and math.isnan(self.pressure_call_s):
             serial = self.pressure_idiom in ("alicat", "nordson")
             object.__setattr__(self, "pressure_call_s", SERIAL_CALL_S if serial else 0.0)
         v = self.pressure_call_s
-        if isinstance(v, bool) or not isinstance(v, int | float) or not (math.isfinite(v) and v >= 0):
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, int | float)
+            or not (math.isfinite(v) and v >= 0)
+        ):
             raise _bad("pressure_call_s", f"must be a time in s >= 0; got {v!r}")
 
     def _check_numbers(self) -> None:
@@ -484,7 +495,11 @@ class MachineProfile:
                 if not isinstance(v, list | tuple) or not all(isinstance(c, str) for c in v):
                     raise _bad(k, f"must be a list of strings; got {v!r}")
                 data[k] = tuple(v)
-            elif k.endswith(("_template", "_idiom")) or k in ("controller", "rotary_rebase") or isinstance(default, str):
+            elif (
+                k.endswith(("_template", "_idiom"))
+                or k in ("controller", "rotary_rebase")
+                or isinstance(default, str)
+            ):
                 if not isinstance(v, str):
                     raise _bad(k, f"has the wrong type {type(v).__name__}; got {v!r}")
             elif isinstance(v, bool) or not isinstance(v, int | float):

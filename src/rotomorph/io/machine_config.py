@@ -232,7 +232,7 @@ _NOTES = {
     ],
     "reprapfirmware": [
         "RepRapFirmware 3 with a rotary axis C (M584 C.. R1 in config.g).",
-        "- M42 P<n> needs the ports configured with M950 P<n> C\"<pin>\" Q<pwm frequency>.",
+        '- M42 P<n> needs the ports configured with M950 P<n> C"<pin>" Q<pwm frequency>.',
         "- Put the lines below in sys/cancel.g (run on a cancelled print) and make M226 (the",
         "  UV-cure pause) run them too in sys/pause.g if a pause may be left long.",
     ],
@@ -259,4 +259,7 @@ def write_machine_config(m: MachineProfile, program: str, folder: str | FilePath
     """Write :func:`controller_files` into ``folder`` (created if missing), atomically each."""
     folder = FilePath(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    return [atomic_write_text(folder / name, text) for name, text in controller_files(m, program).items()]
+    return [
+        atomic_write_text(folder / name, text)
+        for name, text in controller_files(m, program).items()
+    ]
