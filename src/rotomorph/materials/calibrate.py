@@ -3,7 +3,9 @@
 Predictors (:func:`predict`, keyed by :class:`~rotomorph.materials.measurements.MeasuredTable`
 name; straight filaments, full actuation, R = 0.3 mm, inks ``"lce"`` / ``"acrylate"``):
 
-* ``janus_curvature``: K_J (1/mm) of a half-and-half filament printed at speed x (mm/s), ω* = 0;
+* ``janus_curvature``: K_J (1/mm) of a half-and-half filament printed at speed x (mm/s), ω* = 0:
+  the curvature of the heated filament per unit current length (what the paper measured on
+  images of heated filaments);
 * ``pure_lce_length``: L/L0 of a pure LCE filament at ω* = x, v = 3 mm/s; the uniform section has
   no natural curvature, so L/L0 = axial stretch (twisted rod);
 * ``composite_length``: L/L0 of the free Janus helix at ω* = x, v = 3 mm/s, with
@@ -40,7 +42,7 @@ from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.measurements import MeasuredTable, load_table
 from rotomorph.materials.morphology import HelixShape, free_helix
 from rotomorph.materials.natural import DIRECTOR_HELIX_SENSE, FilamentModel
-from rotomorph.materials.process import EmpiricalThreshold
+from rotomorph.materials.process import EmpiricalThreshold, strain_to_stretch
 
 #: Print speed of the paper's rotated filaments (Fig. 2F/G), mm/s.
 ROTATION_SERIES_SPEED = 3.0
@@ -55,7 +57,14 @@ def _inks() -> tuple[Material, Material]:
 def janus_curvature(
     model: FilamentModel, speed: FloatArray, radius: float = PAPER_RADIUS
 ) -> FloatArray:
-    """Natural curvature K_J (1/mm, toward the active side) of a Janus filament at ω* = 0.
+    """Curvature K_J (1/mm, toward the active side) of a heated Janus filament at ω* = 0.
+
+    The paper's Fig. 2D quantity, "the maximum curvature of the actuated filament", measured on
+    images of filaments heated in the bath: the curvature of the heated centre line per unit of
+    its *current* length, K/λ, where K is the natural curvature per printed length (a turning
+    angle per printed length, :mod:`rotomorph.materials.natural`) and λ the natural stretch of
+    the centre line. It is the curvature of :func:`filament_shapes` at ω* = 0 (a ring), of
+    :func:`rotomorph.predict` and of the rod solver's heated shape.
 
     Parameters
     ----------
@@ -69,8 +78,8 @@ def janus_curvature(
     active, passive = _inks()
     section = model.section(active, passive, radius, 0.5)
     e_par, e_perp, eps_p = model.strains(np.asarray(speed, dtype=float), passive)
-    _, kappa, _ = section.natural_strains(0.0, e_par, e_perp, eps_p)
-    return kappa[:, 0]
+    eps_c, kappa, _ = section.natural_strains(0.0, e_par, e_perp, eps_p)
+    return kappa[:, 0] / strain_to_stretch(eps_c, model.strain_model.measure)
 
 
 def filament_shapes(

@@ -140,7 +140,7 @@ def _curvature_section(val: Validation, figs: Path) -> tuple[list[dict], list[Pa
         janus_curvature(val.model, v),
         predicted_x=v,
         xlabel="print speed v (mm/s)",
-        ylabel="Janus curvature K_J (1/mm)",
+        ylabel="curvature of the heated filament K_J (1/mm of its length)",
         predicted_label="fit to all filament groups",
         title="Fig. 2D: curvature vs print speed (ω* = 0)",
         out_of_sample=(

@@ -6,7 +6,7 @@ Every measured group is predicted by the model calibrated **without** it
 ==========================  ====================================================  ==============
 group                       predictor                                             fitted in
 ==========================  ====================================================  ==============
-``janus_curvature``         K_J(v) of the Janus section (closed form)             calibration
+``janus_curvature``         K_J(v) of the heated Janus filament (closed form)     calibration
 ``pure_lce_length``         L/L0 of the free helix, pure LCE (closed form)        calibration
 ``composite_length``        L/L0 of the free helix, Janus composite               calibration
 ``sinusoid_end_to_end``     zero-energy shape of the printed sinusoid design      never
@@ -268,7 +268,11 @@ def _closed_form_rows(group: str, fit: Fit, full: Fit) -> list[dict[str, Any]]:
         "composite_length": ("composite_length_L_over_L0", "1", "fig2fg_length_vs_rotation.png"),
     }
     quantity, unit, figure = labels[group]
-    how = "closed form (Janus section)" if group == "janus_curvature" else "free helix"
+    how = (
+        "closed form (Janus section; curvature of the heated filament per current length)"
+        if group == "janus_curvature"
+        else "free helix"
+    )
     return [
         row(
             quantity,
