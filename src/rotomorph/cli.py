@@ -253,12 +253,14 @@ def _cmd_validate(args: argparse.Namespace) -> int:
         raise UsageError("validate: give DESIGN.toml (or --schema)")
     # the same path as simulate and gcode: load_design (schema, ranges, size), then programs
     from rotomorph.io.gcode import gcode_text
+    from rotomorph.io.placement import check_placement
 
     design = _load_design(args.design)
     programs = design.to_programs()
     _check_materials(programs)
     machine_note = f"; fits machine {args.machine or 'built-in default'}"
     try:
+        check_placement(design, _machine(args, note=False))  # names the design key to change
         gcode_text(programs, _machine(args, note=False), **design.gcode_options())
     except MachineLimitError as err:
         if args.machine is not None:
@@ -306,6 +308,7 @@ def _machine(args: argparse.Namespace, *, note: bool = True) -> Any:
 def _cmd_gcode(args: argparse.Namespace) -> int:
     from rotomorph.io.gcode import plan_programs, write_gcode
     from rotomorph.io.gcode_read import check_gcode
+    from rotomorph.io.placement import check_placement
 
     if args.check is not None:
         if (
@@ -341,6 +344,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     programs = design.to_programs()
     _check_materials(programs)
     options = design.gcode_options()
+    check_placement(design, machine)  # a refusal that names filaments[i].start / lattice.origin
     write_gcode(programs, out, machine, **options, layer_cure_s=args.cure)
     _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
     _gcode_extras(args, out, machine, options)

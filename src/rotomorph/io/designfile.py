@@ -514,7 +514,11 @@ class LatticeModel(_Process):
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
     active_material: ActiveMaterial = Field("lce", description="registered active material")
     passive_material: PassiveMaterial = Field("acrylate", description="registered passive material")
-    origin: Vec3 = Field((0.0, 0.0, 0.0), description="where the lattice is printed (mm)")
+    origin: Vec3 = Field(
+        (20.0, 20.0, 0.0),
+        description="where the lattice's first branch node is printed (mm); the default keeps "
+        "the lattice 20 mm inside the machine's corner, within every example machine",
+    )
     flip_length: float = Field(
         0.0,
         ge=0,

@@ -130,5 +130,8 @@ def write_gcode(
         machine = load_machine_profile(FilePath(machine))
     if isinstance(design, Sequence) and not isinstance(design, str):
         return write(list(design), FilePath(path), machine, **options)
+    from rotomorph.io.placement import check_placement
+
     d = _design(design)
+    check_placement(d, machine)  # a refusal that names the design key to change
     return write(d.to_programs(), FilePath(path), machine, **{**d.gcode_options(), **options})
