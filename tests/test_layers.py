@@ -1,6 +1,6 @@
 """Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis ->
-lattice -> io -> plot -> simulate -> inverse | sweep -> cli; errors, type aliases and geometry
-sit below all."""
+lattice -> io -> plot -> simulate -> inverse | sweep | prediction -> cli; errors, type aliases
+and geometry sit below all."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ LAYERS = [
     {"io"},
     {"plot"},
     {"simulate"},
-    {"inverse", "sweep"},
+    {"inverse", "sweep", "prediction"},
     {"cli", "__main__"},
 ]
 RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}

@@ -11,6 +11,8 @@ Commands::
     rotomorph paper -o OUT/ [--quick]         reproduce the paper's computational figures
     rotomorph sweep SWEEP.toml -o DIR         parameter study (resumable; --scheduler for Dask)
     rotomorph inverse TARGET.toml -o DESIGN.toml   print program for a target shape
+    rotomorph predict DESIGN.toml [--json]    closed-form shapes with the calibration band
+    rotomorph predict --for curvature=0.4     print settings that give a wanted shape
 
 Exit codes: 0 success; 1 the computation failed (solver did not converge);
 2 bad input (command line, design file, machine limits, missing file, existing output folder).
@@ -656,6 +658,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, metavar="DESIGN.toml")
     p.add_argument("--force", action="store_true", help="replace an existing design file")
     p.set_defaults(func=_cmd_inverse)
+
+    from rotomorph.prediction import command as predict
+
+    p = sub.add_parser(
+        "predict",
+        help="closed-form shapes, or the settings for a shape",
+        description=predict.__doc__,
+    )
+    predict.add_arguments(p)
+    p.set_defaults(func=predict.command)
     return parser
 
 
