@@ -29,22 +29,15 @@ def test_curve_summary_and_line_carry_the_verified_state(tmp_path, capsys):
     assert summary["physical"] == {"verdict": "yes", "reason": "all checks passed"}
 
 
-class _Design:
-    """The two attributes the verdict reads (a FilamentDesign stand-in)."""
-
-    def __init__(self, achieved, stable):
-        self.achieved, self.stable = achieved, stable
-
-
 def test_an_overlapping_or_unstable_verified_shape_is_flagged():
     t = np.linspace(0.0, 4 * np.pi, 400)  # two turns of a ring: passes through itself
     ring = np.c_[3 * np.cos(t), 3 * np.sin(t), 0 * t]
-    state = _verified_state(_Design(ring, True), radius=0.3)
+    state = _verified_state(ring, True, radius=0.3)
     assert state["physical"]["verdict"] == "no"
     assert "passes through itself" in state["physical"]["reason"]
     line = np.c_[t, 0 * t, 0 * t]
-    assert _verified_state(_Design(line, False), 0.3)["physical"]["verdict"] == "no"
-    assert _verified_state(_Design(line, None), 0.3)["physical"]["verdict"] == "unknown"
+    assert _verified_state(line, False, 0.3)["physical"]["verdict"] == "no"
+    assert _verified_state(line, None, 0.3)["physical"]["verdict"] == "unknown"
 
 
 @pytest.mark.parametrize(

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from rotomorph.inverse.filament import FilamentDesign
 from rotomorph.inverse.lattice import LatticeDesign, SurfaceTarget, rigid_motion, surface_misfit
+from rotomorph.inverse.simplify import CONVENTION, SimpleProgram
 from rotomorph.plot.figure import new_figure, save_figure
 
-__all__ = ["inverse_figures"]
+__all__ = ["filament_figure", "inverse_figures"]
 
 
 def _equal_3d(ax, pts) -> None:  # type: ignore[no-untyped-def]
@@ -24,12 +26,21 @@ def _equal_3d(ax, pts) -> None:  # type: ignore[no-untyped-def]
     ax.set_zlabel("z (mm)")
 
 
-def _filament(design: FilamentDesign, folder: Path) -> list[Path]:
-    out = []
-    tgt, ach = design.target, design.achieved
+def filament_figure(design: FilamentDesign, program: SimpleProgram | None = None) -> Any:
+    """Target vs achieved shape and the print program of a filament design (a Figure).
+
+    With ``program`` (the printed design) the shape is that design's and the program panels
+    show its segments, in the design file's convention (:data:`CONVENTION`), over the
+    per-vertex solution they simplify.
+    """
+    tgt = design.target
+    ach = design.achieved if program is None else program.achieved
+    rms = design.rms_error if program is None else program.rms_error
+    rel = design.rms_error_rel if program is None else program.rms_error_rel
+    stable = design.stable if program is None else program.stable
     err = np.linalg.norm(ach - tgt, axis=1)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(tgt, axis=0), axis=1))])
-    fig = new_figure(12, 5.2, dpi=150)
+    fig = new_figure(12, 5.6, dpi=150)
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     ax.plot(*tgt.T, color="0.6", lw=6, alpha=0.35, label="target")
     sc = ax.scatter(*ach.T, c=err, cmap="viridis", s=4, vmin=0.0, vmax=max(float(err.max()), 1e-3))
@@ -37,31 +48,74 @@ def _filament(design: FilamentDesign, folder: Path) -> list[Path]:
     _equal_3d(ax, np.vstack([tgt, ach]))
     ax.legend(loc="upper left")
     fig.colorbar(sc, ax=ax, shrink=0.6, pad=0.12, label="distance to target (mm)")
-    unstable = design.stable is False  # the verifying equilibrium: flagged, not a result
+    unstable = stable is False  # the verifying equilibrium: flagged, not a result
     ax.set_title(
-        f"RMS error {design.rms_error:.3g} mm ({100 * design.rms_error_rel:.2g} % of L)"
+        f"RMS error {rms:.3g} mm ({100 * rel:.2g} % of L)"
         + ("\nNOT PHYSICAL: the simulated shape is not a stable minimum" if unstable else ""),
         color="#b2182b" if unstable else "k",
     )
     ax2 = fig.add_subplot(2, 2, 2)
-    ax2.plot(s, design.speed, color="tab:blue")
-    ax2.set_ylabel("print speed v (mm/s)")
-    ax2.grid(alpha=0.3)
     ax3 = fig.add_subplot(2, 2, 4, sharex=ax2)
-    ax3.plot(s, design.omega_star, color="tab:red", label="ω*")
-    ax3.plot(s, design.active_side, color="0.4", lw=0.8, ls="--", label="active side (±1)")
+    thin: dict[str, Any] = {"color": "0.6", "lw": 0.8}
+    ax2.plot(s, design.speed, **thin, label="per-vertex solution")
+    ax3.plot(s, design.rotation_number, **thin, label="per-vertex solution")
+    if program is not None:
+        shown = ""
+        for seg in program.segments:
+            x = [seg.target_start, seg.target_start + seg.target_length]
+            ax2.plot(x, [seg.speed] * 2, color="tab:blue", lw=2)
+            if seg.flip:
+                ax3.axvspan(*x, color="tab:orange", alpha=0.4, lw=0)
+                continue
+            ax3.plot(x, [seg.rotation_number] * 2, color="tab:red", lw=2)
+            if seg.handedness != shown:  # label where the handedness starts or changes
+                ax3.annotate(
+                    seg.handedness, (x[0], seg.rotation_number), xytext=(2, 3),
+                    textcoords="offset points", fontsize=7, color="0.25",
+                )  # fmt: skip
+                shown = seg.handedness
+        ax2.plot([], [], color="tab:blue", lw=2, label="printed segments")
+        ax3.plot([], [], color="tab:red", lw=2, label="printed segments")
+        if any(seg.flip for seg in program.segments):
+            from matplotlib.patches import Patch
+
+            ax3.add_artist(ax3.legend(handles=[Patch(color="tab:orange", alpha=0.4)],
+                                      labels=["flip of the active side"], loc="lower left",
+                                      fontsize=7))  # fmt: skip
+        ax2.set_title(_wrap(program.text()), fontsize=8)
+    top_v = max(float(np.max(design.speed)), *(g.speed for g in getattr(program, "segments", ())))
+    ax2.set_ylim(0.0, 1.2 * top_v)  # from zero: one setting reads as one, not as a zoomed wiggle
+    top_w = max(float(np.max(np.abs(design.rotation_number))), 0.01)
+    if program is not None:
+        top_w = max(top_w, *(abs(g.rotation_number) for g in program.settings))
+    ax3.set_ylim(-1.35 * top_w, 1.35 * top_w)
+    ax3.axhline(0.0, color="0.5", lw=0.6)
+    ax2.set_ylabel("print speed v (mm/s)")
+    ax2.legend(loc="best", fontsize=7)
+    ax2.grid(alpha=0.3)
     bad = np.concatenate([[False], ~design.reachable, [False]])
     if bad.any():
+        lim = max(float(np.max(np.abs(design.rotation_number))), 0.01)
         ax3.fill_between(
-            s, -2.5, 2.5, where=bad, color="tab:orange", alpha=0.25, label="unreachable"
+            s, -lim, lim, where=bad, color="tab:purple", alpha=0.15, label="unreachable"
         )
     ax3.set_xlabel("arc length along the target (mm)")
-    ax3.set_ylabel("rotation number ω*")
-    ax3.legend(loc="best", fontsize=8)
+    ax3.set_ylabel("nozzle rotation number ω*")
+    ax3.legend(loc="best", fontsize=7)
     ax3.grid(alpha=0.3)
-    fig.tight_layout()
-    out.append(save_figure(fig, folder / "target_vs_achieved.png"))
-    return out
+    fig.text(0.5, 0.005, _wrap(CONVENTION, 150), ha="center", va="bottom", fontsize=7, color="0.3")
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    return fig
+
+
+def _wrap(text: str, width: int = 90) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
+
+
+def _filament(design: FilamentDesign, folder: Path, program: SimpleProgram | None) -> list[Path]:
+    return [save_figure(filament_figure(design, program), folder / "target_vs_achieved.png")]
 
 
 def _lattice(design: LatticeDesign, folder: Path) -> list[Path]:
@@ -131,10 +185,17 @@ def _on_surface(design: LatticeDesign, target: SurfaceTarget, folder: Path) -> P
     return save_figure(fig, folder / "target_vs_achieved.png")
 
 
-def inverse_figures(result: FilamentDesign | LatticeDesign, folder: str | Path) -> list[Path]:
-    """Write the figures of an inverse design into ``folder``; returns the paths."""
+def inverse_figures(
+    result: FilamentDesign | LatticeDesign,
+    folder: str | Path,
+    program: SimpleProgram | None = None,
+) -> list[Path]:
+    """Write the figures of an inverse design into ``folder``; returns the paths.
+
+    ``program``: a filament's printed design (:class:`~rotomorph.inverse.simplify.SimpleProgram`).
+    """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     if isinstance(result, FilamentDesign):
-        return _filament(result, folder)
+        return _filament(result, folder, program)
     return _lattice(result, folder)

@@ -70,7 +70,9 @@ class FilamentDesign:
     speed
         Print speed per vertex ``(N,)`` (mm/s).
     omega_star
-        Signed director rotation rate ω* per vertex ``(N,)``.
+        Signed rate at which the interface (and the director helix) turns in the filament's
+        frame, R dα/ds per vertex ``(N,)``; the nozzle's rotation number of the design file is
+        :attr:`rotation_number` = −``omega_star``.
     active_side
         +1 / −1 per vertex: which side of the curvature normal the active half sits on.
     reachable
@@ -106,6 +108,13 @@ class FilamentDesign:
     flips: int
     notes: list[str] = field(default_factory=list)
     stable: bool | None = None
+
+    @property
+    def rotation_number(self) -> FloatArray:
+        """The nozzle's rotation number per vertex ``(N,)``, as design files and G-code state it
+        (:data:`rotomorph.inverse.simplify.CONVENTION`): on a straight print path the interface
+        turns against the nozzle (α = ψ − α_n), so this is ``-omega_star``."""
+        return -self.omega_star
 
     @property
     def fully_reachable(self) -> bool:

@@ -23,6 +23,14 @@ from rotomorph._typing import FloatArray
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.inverse.filament import FilamentDesign, design_filament
 from rotomorph.inverse.lattice import LatticeDesign, design_lattice
+from rotomorph.inverse.response import cached_response_table
+from rotomorph.inverse.simplify import (
+    CONVENTION,
+    ROTATION_STEP,
+    SPEED_STEP,
+    SimpleProgram,
+    simplest_program,
+)
 from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
@@ -53,7 +61,10 @@ class InverseRun:
     log
         Convergence log rows ``(iteration, objective)``.
     result
-        The :class:`FilamentDesign` or :class:`LatticeDesign`.
+        The :class:`FilamentDesign` (the per-vertex solution) or :class:`LatticeDesign`.
+    program
+        Filaments: the printed design, the simplest one within the target's tolerance
+        (:class:`~rotomorph.inverse.simplify.SimpleProgram`); ``design`` is its file.
     """
 
     target: TargetFile
@@ -61,6 +72,7 @@ class InverseRun:
     summary: dict[str, Any]
     log: list[tuple[int, float]] = field(default_factory=list)
     result: FilamentDesign | LatticeDesign | None = None
+    program: SimpleProgram | None = None
 
 
 def _groups(values: FloatArray, tol: FloatArray) -> list[tuple[int, int]]:
@@ -162,30 +174,69 @@ def run_inverse(
     name = target.name or target.kind
     if target.kind == "curve":
         assert target.curve is not None
+        speeds = (opt.min_speed, opt.max_speed)
+        table = cached_response_table(
+            speed_range=speeds,
+            max_omega_star=min(opt.radius * opt.max_rotation / opt.min_speed, 2.5),
+            radius=opt.radius,
+            temperature=opt.temperature,
+            model=None,
+        )
         fil = design_filament(
             curve_points(target.curve),
             spacing=opt.spacing,
             radius=opt.radius,
             temperature=opt.temperature,
-            speed_range=(opt.min_speed, opt.max_speed),
+            speed_range=speeds,
             max_rotation=opt.max_rotation,
+            table=table,
         )
+        simple = simplest_program(
+            fil,
+            table,
+            tolerance=opt.tolerance,
+            speed_range=speeds,
+            max_rotation=opt.max_rotation,
+            spacing=opt.spacing,
+            temperature=opt.temperature,
+            name=name,
+        )
+        runs = simple.settings
+        notes = list(fil.notes)
+        if not simple.within_tolerance:
+            notes.append(
+                f"no design of rounded, piecewise-constant settings met the tolerance "
+                f"{100 * opt.tolerance:.2g} % of the length; the closest is returned"
+            )
         summary: dict[str, Any] = {
             "kind": "curve",
             "family": target.curve.family,
             "length_mm": float(np.sum(np.linalg.norm(np.diff(fil.target, axis=0), axis=1))),
-            "rms_error_mm": fil.rms_error,
-            "rms_error_rel": fil.rms_error_rel,
+            "print_settings": simple.text(),
+            "segments": [seg.record() for seg in simple.segments],
+            "segment_count": len(runs),
+            "rounding": {"speed_mm_s": SPEED_STEP, "rotation_number": ROTATION_STEP},
+            "conventions": CONVENTION,
+            "handedness": sorted({seg.handedness for seg in runs}),
+            "rms_error_mm": simple.rms_error,
+            "rms_error_rel": simple.rms_error_rel,
+            "tolerance_rel": opt.tolerance,
+            "within_tolerance": simple.within_tolerance,
+            "rms_error_rel_per_vertex_design": fil.rms_error_rel,
             "fully_reachable": fil.fully_reachable,
             "unreachable_stretches_mm": fil.unreachable_stretches(),
             "flips": fil.flips,
-            "speed_range_mm_s": [float(fil.speed.min()), float(fil.speed.max())],
-            "omega_star_range": [float(fil.omega_star.min()), float(fil.omega_star.max())],
-            "notes": fil.notes,
-            "verified_by": "forward simulation of the designed program (free filament)",
-            **_verified_state(fil, opt.radius),
+            "speed_range_mm_s": [min(x.speed for x in runs), max(x.speed for x in runs)],
+            "rotation_number_range": [
+                min(x.rotation_number for x in runs),
+                max(x.rotation_number for x in runs),
+            ],
+            "notes": notes,
+            "verified_by": "forward simulation of the design file's print program (free "
+            "filament; rod solver)",
+            **_verified_state(simple.achieved, simple.stable, opt.radius),
         }
-        return InverseRun(target, filament_design_file(fil, name), summary, [], fil)
+        return InverseRun(target, simple.design, summary, [], fil, simple)
     assert target.lattice is not None
     spec = target.lattice
     lat = sinusoidal_lattice(
@@ -240,24 +291,24 @@ def run_inverse(
     return InverseRun(target, design_file, summary, log, des)
 
 
-def _verified_state(fil: FilamentDesign, radius: float) -> dict[str, Any]:
+def _verified_state(achieved: FloatArray, stable: bool | None, radius: float) -> dict[str, Any]:
     """Whether the verifying equilibrium of a filament design is physical: a certified stable
     minimum whose filament does not pass through itself (no contact is modelled)."""
     from rotomorph.simulate.run_data import chain_clearance
 
-    clearance = float(chain_clearance(fil.achieved[None], 2.0 * radius)[0])
+    clearance = float(chain_clearance(achieved[None], 2.0 * radius)[0])
     reasons = []
-    if fil.stable is False:
+    if stable is False:
         reasons.append("the verifying equilibrium is not a stable minimum")
     if clearance < 1.0:
         reasons.append(
             f"the achieved shape passes through itself (clearance {clearance:.2f} diameters, "
             "contact not modelled)"
         )
-    verdict = "no" if reasons else ("unknown" if fil.stable is None else "yes")
+    verdict = "no" if reasons else ("unknown" if stable is None else "yes")
     reason = "; ".join(reasons) or ("stability not checked" if verdict == "unknown" else "")
     return {
-        "stable": fil.stable,
+        "stable": stable,
         "min_clearance_diameters": min(clearance, 2.0),
         "physical": {"verdict": verdict, "reason": reason or "all checks passed"},
     }
@@ -279,7 +330,7 @@ def write_inverse(run: InverseRun, design_path: str | Path) -> list[Path]:
     w.writerows(run.log)
     out.append(atomic_write_text(folder / "convergence.csv", buf.getvalue()))
     if run.result is not None:
-        out += inverse_figures(run.result, folder)
+        out += inverse_figures(run.result, folder, program=run.program)
     return out
 
 
@@ -301,10 +352,13 @@ def inverse_file(
         state = {"yes": "verified state physical", "unknown": "verified state unverified"}.get(
             s["physical"]["verdict"], f"verified state NOT PHYSICAL: {s['physical']['reason']}"
         )
+        within = "" if s["within_tolerance"] else " (NOT within the tolerance)"
         return (
-            f"wrote {design_path} and {folder}/: RMS error {s['rms_error_mm']:.3g} mm "
-            f"({100 * s['rms_error_rel']:.2g} % of the length), {reach}, {s['flips']} flips; "
-            f"{state}"
+            f"wrote {design_path} and {folder}/: {s['print_settings']} (speed to "
+            f"{SPEED_STEP:g} mm/s, ω* to {ROTATION_STEP:g}; ω* > 0: nozzle counter-clockwise "
+            f"from above); RMS error {s['rms_error_mm']:.3g} mm ({100 * s['rms_error_rel']:.2g} "
+            f"% of the length, tolerance {100 * s['tolerance_rel']:.2g} %){within}, {reach}, "
+            f"{s['flips']} flips; {state}"
         )
     k_t, k_a = s["target_gaussian_curvature"], s["achieved_gaussian_curvature"]
     kt = "" if k_t is None else f"target K {k_t:.3g} 1/mm², "

@@ -42,7 +42,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
-from rotomorph.io.designfile import ContactModel, schema_error
+from rotomorph.io.designfile import ContactModel, Vec3, schema_error
 
 __all__ = ["TargetFile", "curve_points", "load_target", "parse_target"]
 
@@ -62,7 +62,7 @@ class CurveSpec(_Model):
     radius: Positive | None = None
     pitch: float | None = Field(None, allow_inf_nan=False)
     turns: Positive | None = None
-    points: list[tuple[float, float, float]] | None = None
+    points: list[Vec3] | None = None  # TOML arrays [x, y, z] (mm)
     samples_per_turn: int = Field(120, ge=16, le=2000)
 
     @model_validator(mode="after")
@@ -116,6 +116,7 @@ class Options(_Model):
     max_rotation: Positive = 40.0
     max_iterations: int = Field(30, ge=1, le=500)
     radius: Positive = 0.3
+    tolerance: float = Field(0.005, gt=0, le=0.2, allow_inf_nan=False)
 
 
 class TargetFile(_Model):
