@@ -42,6 +42,9 @@ def test_readme_has_the_two_quickstart_commands():
     assert any(c.startswith("pip install") for c in cmds)
     assert any(c.startswith("python -m pytest") for c in cmds)
     assert any(c.startswith("rotomorph ") for c in cmds)
+    # the quick answers: a design's closed-form shapes and the settings for a wanted shape
+    assert any(c.startswith("rotomorph predict examples/designs/") for c in cmds)
+    assert any(c.startswith("rotomorph predict --for ") for c in cmds)
 
 
 def _tracked_copy(dest: Path) -> None:
