@@ -309,13 +309,16 @@ def _segments(
         rotation = _round(-w, ROTATION_STEP) + 0.0  # the nozzle's ω* (design files)
         flip_len = 0.0
         if k > 0 and side[a] != side[runs[k - 1][0]]:
-            flip_len = min(
-                _ceil(1.05 * math.pi * v / max_rotation, 1e-3), _floor(0.5 * length_p, 1e-3)
+            # at the rotation limit, but never more than half the run (a run shorter than the
+            # limit needs can only come from a side that changes within a few vertices)
+            flip_len = max(
+                min(_ceil(1.05 * math.pi * v / max_rotation, 1e-3), _floor(0.5 * length_p, 1e-3)),
+                1e-3,
             )
             turn = -1.0 if rotation > 0 else 1.0
             flip_rot = _round(rotation + turn * math.pi * radius / flip_len, ROTATION_STEP)
             segs.append(Segment(start, flip_len * lam, flip_len, v, flip_rot, True, ""))
-        rest = _round(length_p - flip_len, 1e-3)
+        rest = max(_round(length_p - flip_len, 1e-3), 1e-3)
         segs.append(
             Segment(
                 start + flip_len * lam, end - start - flip_len * lam, rest, v, rotation, False,
