@@ -455,7 +455,11 @@ def settings_for(request: Mapping[str, float], *, active_fraction: float = 0.5) 
         printable=printable,
         achieved=achieved,
         free=how,
-        active_side="active half on the inner side of the bend (toward the centre of curvature)",
+        active_side=(
+            "active half on the inner side of the bend (toward the centre of curvature)"
+            if active_fraction < 1.0
+            else "the whole section active (pure LCE)"
+        ),
         handedness=handedness(achieved["twist"].value) if abs(pw) > 0 else "planar",
         range=rng,
         active_fraction=active_fraction,
