@@ -72,6 +72,15 @@ def _progress(total: int, desc: str) -> Any:
     return tqdm(total=total, desc=desc, unit="step", disable=not sys.stderr.isatty(), leave=False)
 
 
+class _SafeFormatter(logging.Formatter):
+    """Log lines with what a file contributed escaped (:func:`rotomorph._text.terminal_safe`)."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        from rotomorph._text import terminal_safe
+
+        return terminal_safe(super().format(record))
+
+
 def _show_progress() -> bool:
     """Progress (bars, phases, the compile note) goes to a terminal or with --verbose."""
     return sys.stderr.isatty() or logging.getLogger("rotomorph").isEnabledFor(logging.INFO)
@@ -85,7 +94,7 @@ def _phases() -> Iterator[None]:
         yield
         return
     handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("rotomorph: %(message)s"))
+    handler.setFormatter(_SafeFormatter("rotomorph: %(message)s"))
     old = (log.level, log.propagate)
     log.addHandler(handler)
     log.setLevel(logging.INFO)
@@ -231,7 +240,10 @@ def _check_writable(path: Path, *, create_parent: bool, inputs: Sequence[Path] =
 
 
 def _print(text: str) -> None:
-    sys.stdout.write(text + "\n")
+    """Text on stdout; anything a file contributed is escaped (never a terminal command)."""
+    from rotomorph._text import terminal_safe
+
+    sys.stdout.write(terminal_safe(text, newlines=True) + "\n")
 
 
 # ----------------------------------------------------------------------------- commands
@@ -708,9 +720,10 @@ def _main(argv: Sequence[str] | None) -> int:
         if args.command is None:
             parser.print_help(sys.stderr)
             return EXIT_USAGE
+        handler = logging.StreamHandler()
+        handler.setFormatter(_SafeFormatter("rotomorph: %(levelname)s: %(message)s"))
         logging.basicConfig(
-            level=logging.INFO if args.verbose else logging.WARNING,
-            format="rotomorph: %(levelname)s: %(message)s",
+            level=logging.INFO if args.verbose else logging.WARNING, handlers=[handler]
         )
         _announce_compiling(args)
         return int(args.func(args))
@@ -736,7 +749,9 @@ def _main(argv: Sequence[str] | None) -> int:
 
 
 def _fail(message: str, code: int) -> int:
-    line = " ".join(message.split())
+    from rotomorph._text import terminal_safe
+
+    line = terminal_safe(" ".join(message.split()))
     sys.stderr.write(f"rotomorph: error: {line}\n")
     return code
 

@@ -32,21 +32,59 @@ touch and rest as ``rotomorph simulate`` will; it is copied into the resulting d
 
 from __future__ import annotations
 
+import itertools
 import math
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Final, Literal
 
 import numpy as np
-import tomllib
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 
 from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
-from rotomorph.io.designfile import ContactModel, Vec3, schema_error
+from rotomorph.io.design_limits import LIMITS
+from rotomorph.io.designfile import ContactModel, Label, as_vector3, schema_error
+from rotomorph.io.tomlfile import read_toml
 
-__all__ = ["TargetFile", "curve_points", "load_target", "parse_target"]
+__all__ = [
+    "BYTES_PER_NODE",
+    "CPU_S_PER_NODE",
+    "MAX_CURVE_NODES",
+    "MAX_CURVE_SAMPLES",
+    "MAX_GRID",
+    "MAX_POINTS",
+    "TargetFile",
+    "curve_length",
+    "curve_points",
+    "load_target",
+    "parse_target",
+]
 
+#: Largest designed filament (rod vertices at ``options.spacing`` along the target).
+MAX_CURVE_NODES: Final = 100_000
+#: Most samples of a generated target curve (``samples_per_turn`` × ``turns``).
+MAX_CURVE_SAMPLES: Final = 1_000_000
+#: Most points of a ``points`` target, and of each axis of a height map.
+MAX_POINTS: Final = 100_000
+MAX_GRID: Final = 1_000
+#: CPU time of a curve design per designed vertex (s; 0.9 ms measured at 3 500 vertices on a
+#: 2-core machine, table lookup, per-vertex fit and the verifying solve), and its memory (bytes).
+CPU_S_PER_NODE: Final = 1e-3
+BYTES_PER_NODE: Final = 4_000
+
+_EXTENT, _COORD = LIMITS["extent"], LIMITS["coordinate"]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+#: A length or radius (mm) within the design file's range.
+Extent = Annotated[float, Field(ge=_EXTENT.minimum, le=_EXTENT.maximum)]
+Coordinate = Annotated[float, Field(ge=_COORD.minimum, le=_COORD.maximum)]
+Point = Annotated[tuple[Coordinate, Coordinate, Coordinate], BeforeValidator(as_vector3)]
 
 
 class _Model(BaseModel):
@@ -57,12 +95,12 @@ class CurveSpec(_Model):
     """A target centre line."""
 
     family: Literal["helix", "spiral", "tendril", "points"]
-    radius_start: Positive | None = None
-    radius_end: Positive | None = None
-    radius: Positive | None = None
-    pitch: float | None = Field(None, allow_inf_nan=False)
-    turns: Positive | None = None
-    points: list[Vec3] | None = None  # TOML arrays [x, y, z] (mm)
+    radius_start: Extent | None = None
+    radius_end: Extent | None = None
+    radius: Extent | None = None
+    pitch: Coordinate | None = Field(None, description="mm per turn (< 0: left-handed)")
+    turns: float | None = Field(None, gt=0, le=10_000)
+    points: list[Point] | None = Field(None, max_length=MAX_POINTS)
     samples_per_turn: int = Field(120, ge=16, le=2000)
 
     @model_validator(mode="after")
@@ -78,15 +116,42 @@ class CurveSpec(_Model):
             raise ValueError(f"family '{self.family}' needs {', '.join(missing)}")
         if self.family == "points" and self.points is not None and len(self.points) < 3:
             raise ValueError("points needs at least 3 points [[x, y, z], ...] (mm)")
+        samples = self.samples()
+        if samples > MAX_CURVE_SAMPLES:
+            raise ValueError(
+                f"turns: {self.turns:g} turns at {self.samples_per_turn} samples per turn are "
+                f"{samples:,.0f} samples (~{24 * samples / 2**30:.3g} GiB); the limit is "
+                f"{MAX_CURVE_SAMPLES:,}: fewer turns or samples_per_turn"
+            )
         return self
+
+    def samples(self) -> float:
+        """Samples of the generated curve (the number of points of a ``points`` target)."""
+        if self.family == "points":
+            return float(len(self.points or ()))
+        factor = 2 if self.family == "tendril" else 1
+        return factor * self.samples_per_turn * float(self.turns or 0.0)
+
+
+def curve_length(spec: CurveSpec) -> float:
+    """Arc length (mm) of a curve target, computed from its parameters (not sampled)."""
+    if spec.family == "points":
+        pts = np.asarray(spec.points, dtype=float)
+        return float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
+    turns = float(spec.turns or 0.0)
+    pitch = float(spec.pitch or 0.0)
+    if spec.family == "tendril":
+        return 2 * turns * math.hypot(2 * math.pi * float(spec.radius or 0.0), pitch)
+    r = max(float(spec.radius_start or 0.0), float(spec.radius_end or 0.0))
+    return turns * math.hypot(2 * math.pi * r, pitch)
 
 
 class LatticeSpec(_Model):
     """Printed lattice geometry to design on (assumed: the paper does not give it)."""
 
     n: int = Field(5, ge=2, le=12)
-    spacing: Positive = 5.0
-    amplitude: float = Field(1.25, ge=0, allow_inf_nan=False)
+    spacing: Extent = 5.0
+    amplitude: float = Field(1.25, ge=0, le=_EXTENT.maximum)
     ghost_nodes: int = Field(10, ge=2, le=40)
 
 
@@ -100,22 +165,41 @@ class SurfaceSpec(_Model):
 class HeightMapSpec(_Model):
     """Heights ``z[i][j]`` (mm) at ``(x[i], y[j])`` (mm), centred on the lattice."""
 
-    x: list[float] = Field(min_length=4)
-    y: list[float] = Field(min_length=4)
-    z: list[list[float]]
+    x: list[Coordinate] = Field(min_length=4, max_length=MAX_GRID)
+    y: list[Coordinate] = Field(min_length=4, max_length=MAX_GRID)
+    z: list[list[Coordinate]] = Field(max_length=MAX_GRID)
+
+    @model_validator(mode="after")
+    def _grid(self) -> HeightMapSpec:
+        if len(self.z) != len(self.x) or any(len(row) != len(self.y) for row in self.z):
+            shape = f"{len(self.z)} rows of {sorted({len(r) for r in self.z})} values"
+            raise ValueError(
+                f"z must have len(x) = {len(self.x)} rows of len(y) = {len(self.y)} heights "
+                f"(mm); got {shape}"
+            )
+        for axis in ("x", "y"):
+            v = getattr(self, axis)
+            if any(b <= a for a, b in itertools.pairwise(v)):
+                raise ValueError(f"{axis} must be strictly increasing (mm)")
+        return self
+
+
+def _limited(kind: str, default: float) -> Any:
+    lim = LIMITS[kind]
+    return Field(default, ge=lim.minimum, le=lim.maximum, description=lim.unit)
 
 
 class Options(_Model):
     """Settings of the design run."""
 
-    spacing: Positive = 0.1
+    spacing: float = _limited("vertex_spacing", 0.1)
     temperature: float = Field(175.0, ge=-50, le=300)
-    min_speed: Positive = 0.25
-    max_speed: Positive = 3.0
-    speed_resolution: Positive = 0.05
-    max_rotation: Positive = 40.0
+    min_speed: float = _limited("speed", 0.25)
+    max_speed: float = _limited("speed", 3.0)
+    speed_resolution: float = Field(0.05, ge=0.001, le=LIMITS["speed"].maximum)
+    max_rotation: float = Field(40.0, gt=0, le=LIMITS["rotation"].maximum)
     max_iterations: int = Field(30, ge=1, le=500)
-    radius: Positive = 0.3
+    radius: float = _limited("filament_radius", 0.3)
     tolerance: float = Field(0.005, gt=0, le=0.2, allow_inf_nan=False)
 
 
@@ -124,7 +208,7 @@ class TargetFile(_Model):
 
     schema_version: Literal[1] = 1
     kind: Literal["curve", "dome", "saddle", "height_map"]
-    name: str = Field("", max_length=200, pattern=r"^[^\x00-\x1f\x7f]*$")
+    name: Label = Field("", description="label of the designed file")
     curve: CurveSpec | None = None
     surface: SurfaceSpec | None = None
     height_map: HeightMapSpec | None = None
@@ -169,6 +253,17 @@ class TargetFile(_Model):
             )
         if self.options.min_speed >= self.options.max_speed:
             raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
+        if self.kind == "curve":
+            assert self.curve is not None
+            nodes = curve_length(self.curve) / self.options.spacing + 1
+            if nodes > MAX_CURVE_NODES:
+                raise ValueError(
+                    f"options.spacing: the {curve_length(self.curve):.4g} mm target at "
+                    f"{self.options.spacing:g} mm spacing is about {nodes:,.0f} filament "
+                    f"vertices (~{nodes * BYTES_PER_NODE / 1e9:.2g} GB, "
+                    f"~{nodes * CPU_S_PER_NODE / 60:.0f} min of CPU); the limit is "
+                    f"{MAX_CURVE_NODES:,}: a larger spacing or a shorter target"
+                )
         return self
 
     def surface_target(self) -> SurfaceTarget:
@@ -266,18 +361,16 @@ def parse_target(data: dict[str, Any]) -> TargetFile:
 
 
 def load_target(path: str) -> TargetFile:
-    """Read and validate a TOML target file (UTF-8)."""
+    """Read and validate a TOML target file (as design files: UTF-8, or UTF-16/32 with a
+    byte-order mark, at most 4 MiB).
+
+    Raises
+    ------
+    InvalidDesignError
+        Unreadable, not UTF-8, not TOML, or not a valid target (field path and fix).
+    """
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
+        data = read_toml(path, InvalidDesignError)
     except OSError as exc:
         raise InvalidDesignError(str(path), f"cannot be read: {exc.strerror}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        raise InvalidDesignError(str(path), "is not UTF-8 text; save it as UTF-8") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidDesignError(str(path), f"is not valid TOML: {exc}") from None
     return parse_target(data)

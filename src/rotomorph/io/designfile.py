@@ -64,6 +64,7 @@ from pydantic import (
     model_validator,
 )
 
+from rotomorph._text import check_text, terminal_safe
 from rotomorph.design.lattices import Lattice, sinusoidal_lattice
 from rotomorph.design.path import (
     Arc,
@@ -96,6 +97,9 @@ __all__ = [
     "SCHEMA_VERSION",
     "ContactModel",
     "Design",
+    "FreeText",
+    "Label",
+    "as_vector3",
     "design_schema",
     "design_size",
     "load_design",
@@ -138,7 +142,7 @@ def _ranged(kind: str, default: Any = ..., description: str = "", **kw: Any) -> 
     return Field(default, le=lim.maximum, description=desc or None, **lo, **kw)  # type: ignore[call-overload]
 
 
-def _as_tuple(value: Any) -> Any:
+def as_vector3(value: Any) -> Any:
     """TOML arrays are lists; a 3-vector field takes a list of exactly three numbers."""
     if isinstance(value, list | tuple):
         if len(value) != 3:
@@ -147,10 +151,16 @@ def _as_tuple(value: Any) -> Any:
     return value
 
 
+#: A label (design or filament name): one line, no control or bidirectional characters.
+Label = Annotated[str, Field(max_length=200), AfterValidator(check_text)]
+#: Free text: may span lines, no other control or bidirectional characters.
+FreeText = Annotated[
+    str, Field(max_length=10_000), AfterValidator(lambda text: check_text(text, newlines=True))
+]
 Speed = Annotated[float, _ranged("speed", description="print speed")]
 Length = Annotated[float, _ranged("extent", description="length")]
 Coordinate = Annotated[float, _ranged("coordinate")]
-Vec3 = Annotated[tuple[Coordinate, Coordinate, Coordinate], BeforeValidator(_as_tuple)]
+Vec3 = Annotated[tuple[Coordinate, Coordinate, Coordinate], BeforeValidator(as_vector3)]
 
 
 class _Model(BaseModel):
@@ -291,7 +301,7 @@ class _Process(_Model):
 class Filament(_Control, _Process):
     """One filament: a chain of segments and how to print it."""
 
-    name: str = Field("", max_length=200, description="label in results and figures")
+    name: Label = Field("", description="label in results and figures")
     speed: Speed = 3.0
     active_side: Literal["outer", "inner"] | None = Field(
         None, description="keep the active half on this side of the curvature"
@@ -664,8 +674,8 @@ class Design(_Model):
     """A validated design file (filaments and/or a lattice)."""
 
     schema_version: Literal[1] = Field(SCHEMA_VERSION, description="format version; write 1")
-    name: str = Field("", max_length=200, description="label stored with results and G-code")
-    description: str = Field("", max_length=10_000, description="free text")
+    name: Label = Field("", description="label stored with results and G-code")
+    description: FreeText = Field("", description="free text (newlines allowed)")
     nozzle: Nozzle = Field(Nozzle(), description="nozzle and pressures for G-code")
     filaments: list[Filament] = Field(
         default_factory=list, max_length=10_000, description="filaments (or a lattice, not both)"
@@ -752,11 +762,6 @@ _TYPE_ERRORS: Final = {
 }
 
 
-def _printable(text: str) -> str:
-    """``text`` with control characters escaped (a key may hold a newline; errors are one line)."""
-    return text if text.isprintable() else text.encode("unicode_escape").decode("ascii")
-
-
 def schema_error(err: ErrorDetails) -> tuple[str, str]:
     """``(field, message)`` of one pydantic error, in the words of every rotomorph error
     (``filaments[0].speed``, ``must be >= 0.01 mm/s; got -2.0``); sweep and target files use it
@@ -768,7 +773,7 @@ def schema_error(err: ErrorDetails) -> tuple[str, str]:
         elif part in ("line", "arc", "sinusoid", "polyline") and loc and loc[-1].startswith("["):
             continue  # discriminator tag of a segment
         else:
-            loc.append(("." if loc else "") + _printable(str(part)))
+            loc.append(("." if loc else "") + terminal_safe(str(part)))  # a key may hold ESC
     field = "".join(loc) or "<design>"
     names = [str(part) for part in err["loc"] if isinstance(part, str)]
     unit = _UNITS.get(names[-1] if names else "", "")

@@ -41,16 +41,15 @@ from typing import Annotated, Any, Final, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from rotomorph.errors import InvalidDesignError, InvalidParameterError
-from rotomorph.io.designfile import Design, parse_design, schema_error
+from rotomorph.io.design_limits import LIMITS
+from rotomorph.io.designfile import Design, FreeText, Label, parse_design, schema_error
 from rotomorph.io.machine import MachineProfile, load_machine_profile
+from rotomorph.io.tomlfile import read_toml
+from rotomorph.simulate.options import MAX_STEPS, TEMPERATURE_RANGE
 from rotomorph.sweep.paths import check_path, parse_path
 
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-    import tomli as tomllib  # type: ignore[no-redef]
-
 __all__ = [
+    "MAX_POINTS",
     "SCHEMA_VERSION",
     "Distribution",
     "Parameter",
@@ -64,11 +63,24 @@ __all__ = [
 ]
 
 SCHEMA_VERSION: Final = 1
-Scalar = float | int | str | bool
+#: Most points of a sweep (grid product or samples); each is resolved and held before any run.
+MAX_POINTS: Final = 100_000
+#: Memory to hold one resolved point: about four bytes per byte of the design's JSON (Python
+#: objects) plus the record (measured 2.3 kB per point for a 600-byte filament design).
+PLAN_BYTES_PER_JSON_BYTE: Final = 4
+MIN_POINT_BYTES: Final = 2_300
+#: Resolving one point (set the values, validate the design, hash it): 1.3 ms CPU measured.
+PLAN_S_PER_POINT: Final = 1.3e-3
+Scalar = float | int | Label | bool
 
 
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+def _many(count: float) -> str:
+    """A count for a message: ``1,000,000`` or ``2.75e+15``."""
+    return f"{count:,.0f}" if count < 1e12 else f"{count:.3g}"
 
 
 class Range(_Model):
@@ -93,12 +105,27 @@ class Range(_Model):
             raise ValueError("log = true needs num and start, stop > 0")
         if self.step is not None and self.stop < self.start:
             raise ValueError("step needs stop >= start")
+        count = self.count()
+        if count > MAX_POINTS:
+            what = f"num = {self.num}" if self.num is not None else f"step = {self.step:g}"
+            raise ValueError(
+                f"{what} gives {_many(count)} values (at least ~{count * MIN_POINT_BYTES / 1e9:.3g}"
+                f" GB and ~{count * PLAN_S_PER_POINT / 60:,.0f} min of CPU to resolve them); a "
+                f"sweep has at most {MAX_POINTS:,} points: use fewer values (or random / "
+                "latin_hypercube sampling)"
+            )
         return self
+
+    def count(self) -> float:
+        """Number of values (computed, not listed; may be huge before validation)."""
+        if self.step is not None:
+            return math.floor((self.stop - self.start) / self.step + 1e-9) + 1.0
+        return float(self.num or 0)
 
     def values(self) -> list[float]:
         """The listed values."""
         if self.step is not None:
-            n = math.floor((self.stop - self.start) / self.step + 1e-9)
+            n = int(self.count()) - 1
             return [self.start + i * self.step for i in range(n + 1)]
         assert self.num is not None
         if self.num == 1:
@@ -146,7 +173,7 @@ class Parameter(_Model):
     values: list[Scalar] | None = Field(None, min_length=1)
     range: Range | None = None
     distribution: Distribution | None = None
-    name: str = Field("", description="column name in the results table (default: the path)")
+    name: Label = Field("", description="column name in the results table (default: the path)")
 
     @model_validator(mode="after")
     def _one_source(self) -> Parameter:
@@ -160,6 +187,14 @@ class Parameter(_Model):
     def column(self) -> str:
         """Name of this parameter's column in the results table."""
         return self.name or self.path
+
+    def count(self) -> float:
+        """Number of levels (``inf`` for a distribution)."""
+        if self.values is not None:
+            return float(len(self.values))
+        if self.range is not None:
+            return self.range.count()
+        return math.inf
 
     def levels(self) -> list[Scalar] | None:
         """The finite list of values (``None`` for a distribution)."""
@@ -204,10 +239,19 @@ class Settings(_Model):
     """
 
     method: Literal["rod", "closed_form"] = "rod"
-    steps: int = Field(8, ge=1, description="heating steps")
-    start_temperature: float = Field(25.0, description="°C")
-    temperature: float = Field(175.0, description="°C")
-    spacing: float | None = Field(None, gt=0, description="vertex spacing override (mm)")
+    steps: int = Field(8, ge=1, le=MAX_STEPS, description="heating steps")
+    start_temperature: float = Field(
+        25.0, ge=TEMPERATURE_RANGE[0], le=TEMPERATURE_RANGE[1], description="°C"
+    )
+    temperature: float = Field(
+        175.0, ge=TEMPERATURE_RANGE[0], le=TEMPERATURE_RANGE[1], description="°C"
+    )
+    spacing: float | None = Field(
+        None,
+        ge=LIMITS["vertex_spacing"].minimum,
+        le=LIMITS["vertex_spacing"].maximum,
+        description="vertex spacing override (mm)",
+    )
     actuation: Literal["program", "thermal", "literal", "swapped", "radius", "additive"] = "program"
     filament_model: Literal[
         "calibrated",
@@ -229,8 +273,8 @@ class Sweep(_Model):
     """A validated sweep file."""
 
     schema_version: Literal[1] = SCHEMA_VERSION
-    name: str = ""
-    description: str = ""
+    name: Label = ""
+    description: FreeText = ""
     design: dict[str, Any] = Field(description="the base design (inline; a path is read in)")
     parameters: list[Parameter] = Field(min_length=1)
     sampling: Sampling = Sampling()
@@ -256,7 +300,23 @@ class Sweep(_Model):
                     )
         if len(set(self.outputs)) != len(self.outputs):
             raise ValueError("outputs lists a name twice")
+        points = self.point_count()
+        per_point = PLAN_BYTES_PER_JSON_BYTE * len(json.dumps(self.design, default=str)) + 1000
+        if points > MAX_POINTS:
+            field = "sampling.samples" if self.sampling.method != "grid" else "parameters"
+            raise ValueError(
+                f"{field}: the sweep has {_many(points)} points (~{points * per_point / 1e9:.3g} "
+                f"GB and ~{points * PLAN_S_PER_POINT / 60:,.0f} min of CPU to resolve them "
+                f"before the first run); the limit is {MAX_POINTS:,} points: vary fewer "
+                "values, or sample (random / latin_hypercube)"
+            )
         return self
+
+    def point_count(self) -> float:
+        """Points of the sweep (grid: the product of the levels; else ``samples``)."""
+        if self.sampling.method != "grid":
+            return float(self.sampling.samples or 0)
+        return math.prod(p.count() for p in self.parameters)
 
     def base_design(self) -> Design:
         """The validated base design."""
@@ -303,13 +363,9 @@ def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
     base = Path(folder)
     if isinstance(data.get("design"), str):
         path = base / data["design"]
-        try:
-            with open(path, "rb") as fh:
-                data["design"] = tomllib.load(fh)
-        except FileNotFoundError:
-            raise InvalidParameterError("design", f"{path}: no such design file") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise InvalidDesignError(str(path), f"is not valid TOML: {exc}") from None
+        if not path.is_file():
+            raise InvalidParameterError("design", f"{path}: no such design file")
+        data["design"] = read_toml(path, InvalidDesignError)  # UTF-8, size, syntax
     machine = data.get("machine")
     if isinstance(machine, dict) and "profile" in machine:
         rest = {k: v for k, v in machine.items() if k != "profile"}
@@ -355,15 +411,13 @@ def load_sweep(path: str | Path) -> Sweep:
     Raises
     ------
     InvalidParameterError
+        A file that is not UTF-8 (or UTF-16/32 with a byte-order mark) or larger than 4 MiB,
         TOML syntax errors and schema violations (field path and fix).
+    OSError
+        The file cannot be read.
     """
     p = Path(path)
-    try:
-        with open(p, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidParameterError(str(p), f"is not valid TOML: {exc}") from None
-    return parse_sweep(data, folder=p.parent)
+    return parse_sweep(read_toml(p), folder=p.parent)  # UTF-8, size and syntax as design files
 
 
 SweepSchema = Annotated[dict[str, Any], "JSON Schema"]
