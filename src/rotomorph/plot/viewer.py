@@ -8,6 +8,12 @@ per segment) on one colour scale for the whole ramp. Each frame's title carries 
 verdict (:mod:`rotomorph.io.validity`). Frames carry only what changes (see
 :func:`viewer_figure`), so the file is plotly.js plus little more than one float32 vertex array
 per step.
+
+Every text that comes from the run (filament and design names, field names and units, the
+verdict's reasons, step labels) is escaped for plotly's HTML subset
+(:func:`rotomorph._text.markup_safe`): a name holding ``<a href=…>`` or ``<span style=…>`` is
+shown as those characters, never as a link or styled text. The page links nowhere (no plotly
+logo link).
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from rotomorph._text import markup_safe
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import RunResults
@@ -100,14 +107,19 @@ def write_viewer(
         An unknown field, or plotly missing.
     """
     fig = viewer_figure(results, field=field, facets=facets)
-    html = fig.to_html(include_plotlyjs=include_plotlyjs, full_html=True, auto_play=False)
+    html = fig.to_html(
+        include_plotlyjs=include_plotlyjs,
+        full_html=True,
+        auto_play=False,
+        config={"displaylogo": False},
+    )
     return atomic_write_text(path, html)
 
 
 def _chain_ends(results: RunResults) -> tuple[list[str], list[int]]:
     """Names and last nodes of the run's filaments (none for a single unnamed one)."""
     chains = results.metadata.get("chains", []) or []
-    names = [str(c.get("name") or f"filament {i}") for i, c in enumerate(chains)]
+    names = [markup_safe(str(c.get("name") or f"filament {i}")) for i, c in enumerate(chains)]
     return (names, [int(c["stop"]) - 1 for c in chains]) if len(chains) > 1 else ([], [])
 
 
@@ -133,7 +145,7 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     names = viewer_fields(results)
     if field not in names:
         raise InvalidParameterError(
-            "field", f"{field!r} is not stored in this run; choose one of {', '.join(names)}"
+            "field", f"{field!r} is not stored in this run; choose one of {names!r}"
         )
     s = results.n_steps
     n_fine = len(results.edges)
@@ -145,15 +157,16 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     frac = _per_segment(results.static.get("active_fraction", 0.5), n_fine, pick)
     stored_normals = results.fields.get("active_normal")
     verdicts = assess(results.scalars, results.metadata, s)
-    labels = results.step_labels()
+    labels = [markup_safe(label) for label in results.step_labels()]
     values = None if field == "janus" else coarse.mean(_segment_field(results, field))
     if values is not None:
         # the figures' limits: robust, symmetric for signed data, round-off drawn as neutral
         norm = scalar_norm(values.reshape(-1))
         lo, hi = float(norm.vmin or 0.0), float(norm.vmax or 1.0)
         cscale: Any = "RdBu_r"
-        unit = results.units.get(field, "")
-        cbar = {"title": f"{field} ({unit})" if unit not in ("", "1") else field}
+        unit = str(results.units.get(field, ""))
+        text = f"{field} ({unit})" if unit not in ("", "1") else field
+        cbar = {"title": {"text": markup_safe(text)}}
     else:
         lo, hi = 0.0, 1.0
         cscale = [
@@ -196,7 +209,8 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     def title(k: int) -> str:
         v = verdicts[k] if k < s - 1 else run_verdict(verdicts)
         colour = "#b2182b" if v.verdict == "no" else "black"
-        return f"{labels[k]} (step {k}/{s - 1}) — <span style='color:{colour}'>{v.text()}</span>"
+        verdict = markup_safe(v.text())
+        return f"{labels[k]} (step {k}/{s - 1}) — <span style='color:{colour}'>{verdict}</span>"
 
     def moving(k: int) -> dict[str, Any]:
         verts, inten = meshes[k]
@@ -332,7 +346,7 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
         if values is None
         else ""
     )
-    design_name = str(results.metadata.get("design_name", ""))
+    design_name = markup_safe(str(results.metadata.get("design_name", "")))
     fig = go.Figure(
         data=[tubes, ghost],
         frames=frames,
