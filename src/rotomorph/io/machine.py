@@ -42,6 +42,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path as FilePath
 from typing import Any
 
+from rotomorph._text import terminal_safe
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.tomlfile import read_toml
 
@@ -219,7 +220,8 @@ class MachineProfile:
         Lines after the header comment and at the end of the program.
     header_lines, footer_lines
         Verbatim lines before the setup and after the end (a file may give ``header_file``
-        and ``footer_file``, read relative to the profile; tabs become spaces).
+        and ``footer_file``: ASCII text files of at most 256 KiB in the profile's own folder
+        or below it, named relative to it; tabs become spaces).
     source
         Where the profile came from: the file name, or ``"built-in default"`` (stated in the
         G-code header). Not a file key.
@@ -479,7 +481,8 @@ class MachineProfile:
         known = {f.name for f in fields(cls)} - {"source"}
         unknown = sorted(set(data) - known)
         if unknown:
-            raise _bad(unknown[0], f"unknown setting; known: {sorted(known)}")
+            name = terminal_safe(str(unknown[0]))  # a key may hold ESC
+            raise _bad(name, f"unknown setting; known: {sorted(known)}")
         for k, v in data.items():
             default = getattr(cls, k, None)
             if k == "continuous_rotation":
@@ -507,14 +510,43 @@ class MachineProfile:
         return cls(**data)
 
 
+#: Largest header or footer file read (bytes); an A3200 header is a few kB.
+MAX_HEADER_BYTES = 256 * 1024
+
+
 def _read_lines(key: str, value: object, folder: FilePath | None) -> tuple[str, ...]:
+    """Lines of the ``header_file``/``footer_file`` ``value``: a regular text file inside the
+    profile's ``folder`` (a relative path without ``..``; after following symlinks still
+    inside), so a shared profile cannot copy ``/etc/passwd`` or ``~/.ssh`` into a program."""
     if not isinstance(value, str) or not value:
         raise _bad(key, f"must be a file name; got {value!r}")
-    path = FilePath(value) if folder is None else folder / value
+    fix = "put the file next to the profile and give its name"
+    if folder is None:
+        raise _bad(key, f"needs a profile file to be relative to; give {key[:6]}_lines inline")
+    rel = FilePath(value)
+    if rel.is_absolute() or value.startswith("~"):
+        raise _bad(key, f"must be relative to the profile's folder; got {value!r}: {fix}")
+    if ".." in rel.parts:
+        raise _bad(key, f"must stay inside the profile's folder (no '..'); got {value!r}: {fix}")
+    root = folder.resolve()
+    path = (folder / rel).resolve()
+    if not path.is_relative_to(root):
+        raise _bad(key, f"{value!r} leads outside the profile's folder (a symbolic link?): {fix}")
+    if not path.is_file():
+        raise _bad(key, f"{value!r} is not a file in the profile's folder {folder}")
     try:
-        text = path.read_text(encoding="ascii")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _bad(key, f"cannot read {value!r} as an ASCII text file ({exc})") from None
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_HEADER_BYTES + 1)
+    except OSError as exc:
+        raise _bad(key, f"cannot read {value!r} ({exc.strerror})") from None
+    if len(data) > MAX_HEADER_BYTES:
+        raise _bad(key, f"{value!r} is larger than {MAX_HEADER_BYTES // 1024} KiB")
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise _bad(
+            key, f"{value!r} is not ASCII text (byte 0x{data[exc.start]:02x} at {exc.start})"
+        ) from None
     return tuple(line.expandtabs(4).rstrip() for line in text.splitlines())
 
 
