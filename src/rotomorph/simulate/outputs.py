@@ -41,6 +41,7 @@ from rotomorph.io.vtk import network_lines, write_vtp_series, write_vtu_series
 
 #: Phase messages of the writing steps (a command line shows them; silent by default).
 phase_log = logging.getLogger("rotomorph.progress")
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "colour_field",
@@ -603,8 +604,16 @@ def write_run_results(
         )
     ]
     paths.append(write_summary(out / "summary.json", summarize(results)))
-    phase_log.info("writing: figures%s", " and movie" if movie else "")
-    paths += plot_run(results, out / "figures", movie=movie)
     phase_log.info("writing: ParaView files")
     paths += write_vtk(results, out / "paraview")
+    phase_log.info("writing: figures%s", " and movie" if movie else "")
+    try:
+        paths += plot_run(results, out / "figures", movie=movie)
+    except Exception as err:  # drawing must never cost the computed run
+        logger.warning(
+            "figures not drawn (%s: %s); results.h5, summary.json and paraview/ are kept: "
+            "draw them again with 'rotomorph plot RUN -o FIGURES'",
+            type(err).__name__,
+            " ".join(str(err).split())[:300],
+        )
     return paths

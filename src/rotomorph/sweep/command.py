@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from rotomorph._text import terminal_safe
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import check_writable
 
@@ -130,10 +131,17 @@ def command(args: argparse.Namespace) -> int:
     if args.plot:
         from rotomorph.sweep.figures import plot_sweep
 
-        figs = plot_sweep(
-            result.table, [q.column for q in sweep.parameters], sweep.outputs, out / "figures"
-        )
-        sys.stdout.write(f"wrote {len(figs)} figure(s) to {out / 'figures'}\n")
+        try:
+            figs = plot_sweep(
+                result.table, [q.column for q in sweep.parameters], sweep.outputs, out / "figures"
+            )
+        except Exception as err:  # drawing must never cost the computed sweep (table written)
+            sys.stderr.write(
+                f"rotomorph: warning: figures not drawn ({type(err).__name__}: "
+                f"{terminal_safe(' '.join(str(err).split())[:300])}); the table is kept\n"
+            )
+        else:
+            sys.stdout.write(f"wrote {len(figs)} figure(s) to {out / 'figures'}\n")
     if result.lost:
         sys.stderr.write(
             f"rotomorph: error: {len(result.lost)} run(s) lost to a failed worker "
