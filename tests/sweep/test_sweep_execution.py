@@ -61,7 +61,7 @@ def test_dask_local_cluster_gives_the_same_table(local_result, sweep_file, tmp_p
 
 
 def _records(folder: Path) -> set[str]:
-    return RunStore(folder).finished() if (folder / "runs").is_dir() else set()
+    return set(RunStore(folder).finished()) if (folder / "runs").is_dir() else set()
 
 
 def test_sigkill_and_restart_recomputes_nothing_and_loses_nothing(

@@ -285,7 +285,7 @@ def run_sweep(
     unique = {s.run_id: s for s in specs}
     with RunStore(folder, fsync=fsync) as store:
         _write_plan(store, sweep)
-        done = store.finished() & set(unique)
+        done = set(store.finished(unique))  # trusted records only; damaged ones are redone
         todo = [unique[i] for i in dict.fromkeys(s.run_id for s in specs) if i not in done]
         counts = {"ok": 0, "failed": 0}
         total, skipped = len(unique), len(done)
@@ -308,8 +308,7 @@ def run_sweep(
         if remote:
             with _executor(executor, scheduler, workers) as ex:
                 lost = _drain(ex, evaluate, remote, store_outcome, max(1, max_pending), chunk)
-        finished = store.finished()
-        records = {r: store.read(r) for r in unique if r in finished}
+        records = store.finished(unique)
         table = build_table(sweep, points, [s.run_id for s in specs], records)
         write_table(table, store.folder / TABLE_FILE)
     final = SweepProgress(total, skipped, counts["ok"], counts["failed"])

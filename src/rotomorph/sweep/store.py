@@ -8,28 +8,36 @@ Layout of a sweep folder ``DIR``::
     DIR/results.parquet          the table (:mod:`rotomorph.sweep.table`)
     DIR/.lock                    locked (``lockf``) while a sweep writes to DIR
 
-A run is *finished* exactly when its ``.json`` record exists. Records are written to a
-temporary file and renamed (:func:`rotomorph.io.atomic.atomic_write_text`), after the run's
-HDF5 file, so a killed sweep leaves either a complete run or none; finished runs are never
-recomputed. The lock is released by the operating system when the process dies (even by
-SIGKILL), so a restart never finds a stale lock; two sweeps writing to one folder at the same
-time are refused. Temporary files of a killed writer are hidden (dot-files, never counted as
-records) and deleted by the next lock holder.
+A run is *finished* exactly when its ``.json`` record exists and can be trusted
+(:func:`rotomorph.sweep.records.check_record`: schema, run id, checksum, and the sha256 of its
+HDF5 file). Records are written to a temporary file and renamed
+(:func:`rotomorph.io.atomic.atomic_write_text`), after the run's HDF5 file, so a killed sweep
+leaves either a complete run or none; finished runs are never recomputed. A record that cannot
+be trusted (truncated, empty, binary, copied under another run's id, edited) is reported in one
+warning line naming the file, and its run is computed again. The lock is released by the
+operating system when the process dies (even by SIGKILL), so a restart never finds a stale
+lock; two sweeps writing to one folder at the same time are refused. Temporary files of a
+killed writer are hidden (dot-files, never counted as records) and deleted by the next lock
+holder.
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import RunResults, write_results
+from rotomorph.sweep.records import DamagedRecord, check_record, file_sha256, seal_record
 
 __all__ = ["RunStore"]
+
+logger = logging.getLogger(__name__)
 
 
 class RunStore:
@@ -96,25 +104,59 @@ class RunStore:
         """Where the HDF5 results of ``run_id`` live (when written)."""
         return self.record_path(run_id).with_suffix(".h5")
 
-    def finished(self) -> set[str]:
-        """Ids of every finished run in the folder."""
+    def stored(self) -> set[str]:
+        """Ids of every run with a record file in the folder (trusted or not)."""
         runs = self.folder / "runs"
         return {p.stem for p in runs.glob("*/*.json") if not p.name.startswith(".")}
 
-    def read(self, run_id: str) -> dict[str, Any]:
-        """The record of a finished run."""
-        return json.loads(self.record_path(run_id).read_text(encoding="utf-8"))
+    def finished(self, ids: Iterable[str] | None = None) -> dict[str, dict[str, Any]]:
+        """Trusted records by run id: of every stored run, or of those of ``ids`` stored.
 
-    def records(self, ids: set[str] | None = None) -> Iterator[dict[str, Any]]:
-        """Records of the finished runs (all, or those in ``ids``)."""
-        for run_id in sorted(self.finished() if ids is None else ids):
-            yield self.read(run_id)
+        A record that cannot be trusted is left out (its run counts as not finished) with one
+        warning naming its file and the reason.
+        """
+        stored = self.stored()
+        wanted = stored if ids is None else stored & set(ids)
+        out = {}
+        for run_id in sorted(wanted):
+            path = self.record_path(run_id)
+            try:
+                out[run_id] = check_record(path, run_id)
+            except (DamagedRecord, OSError) as err:
+                reason = err.strerror if isinstance(err, OSError) else str(err)
+                logger.warning(
+                    "sweep record %s %s: ignored, the run is computed again",
+                    path.relative_to(self.folder),
+                    reason,
+                )
+        return out
+
+    def read(self, run_id: str) -> dict[str, Any]:
+        """The trusted record of a finished run.
+
+        Raises
+        ------
+        InvalidParameterError
+            The record is missing or cannot be trusted (naming the file and why).
+        """
+        path = self.record_path(run_id)
+        try:
+            return check_record(path, run_id)
+        except (DamagedRecord, OSError) as err:
+            reason = err.strerror if isinstance(err, OSError) else str(err)
+            raise InvalidParameterError(str(path), str(reason)) from None
+
+    def records(self, ids: Iterable[str] | None = None) -> Iterator[dict[str, Any]]:
+        """Trusted records of the finished runs (all, or those in ``ids``), by id."""
+        yield from self.finished(ids).values()
 
     def write(self, record: Mapping[str, Any], results: RunResults | None = None) -> Path:
-        """Store a finished run: its HDF5 results (if any) first, then its record."""
+        """Store a finished run: its HDF5 results (if any) first, then its record (sealed with
+        its checksum and the HDF5 file's sha256, :func:`~rotomorph.sweep.records.seal_record`)."""
         run_id = str(record["run_id"])
         path = self.record_path(run_id)
         path.parent.mkdir(exist_ok=True)
+        digest = None
         if results is not None:
             write_results(
                 self.results_path(run_id),
@@ -129,5 +171,6 @@ class RunStore:
                 static=results.static,
                 programs=results.programs,
             )
-        text = json.dumps(record, sort_keys=True, allow_nan=False)
+            digest = file_sha256(self.results_path(run_id))
+        text = json.dumps(seal_record(record, digest), sort_keys=True, allow_nan=False)
         return atomic_write_text(path, text + "\n", fsync=self.fsync)
