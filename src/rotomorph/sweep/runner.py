@@ -27,13 +27,14 @@ import json
 import logging
 import os
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
+from rotomorph.sweep.executors import local_executor, open_executor, probe_scheduler
 from rotomorph.sweep.run import RunOutcome, RunSpec, execute_run, resolve_run
 from rotomorph.sweep.sampling import sample_points
 from rotomorph.sweep.spec import Sweep
@@ -124,104 +125,6 @@ def plan_sweep(sweep: Sweep) -> tuple[list[dict[str, Any]], list[RunSpec]]:
     return points, [resolve_run(sweep, p) for p in points]
 
 
-@contextlib.contextmanager
-def _executor(executor: Any, scheduler: str | None, workers: int | None) -> Iterator[cf.Executor]:
-    if executor is not None and scheduler is not None:
-        raise InvalidParameterError("scheduler", "give an executor or a scheduler, not both")
-    if executor is not None:
-        yield executor.get_executor() if hasattr(executor, "get_executor") else executor
-        return
-    if scheduler is not None:
-        try:
-            from distributed import Client
-        except ImportError:  # pragma: no cover - optional dependency
-            raise InvalidParameterError(
-                "scheduler", "needs dask.distributed: pip install 'rotomorph[sweep]'"
-            ) from None
-        try:
-            client = Client(scheduler, timeout="20s")
-        except (OSError, ValueError) as err:  # unreachable, or not an address (no port)
-            raise InvalidParameterError(
-                "scheduler", f"cannot reach the Dask scheduler at {scheduler}: {err}"
-            ) from None
-        with client:
-            yield client.get_executor()
-        return
-    pool = local_executor(workers)
-    try:
-        yield pool
-    except BaseException:  # Ctrl-C or an error: drop queued runs, stop the running ones
-        _terminate(pool)
-        raise
-    pool.shutdown(wait=True)
-
-
-def local_executor(workers: int | None = None) -> cf.ProcessPoolExecutor:
-    """The default local pool: ``workers`` processes (default: CPU count), warmed up.
-
-    Use it as a context manager to share one pool between several sweeps
-    (``run_sweep(..., executor=pool)``).
-    """
-    if workers is not None and workers < 1:
-        raise InvalidParameterError("workers", f"must be >= 1; got {workers}")
-    return cf.ProcessPoolExecutor(
-        max_workers=workers or os.cpu_count() or 1,
-        mp_context=_pool_context(),
-        initializer=_warm_worker,
-        initargs=(os.getpid(),),
-    )
-
-
-def _pool_context() -> Any:
-    """``forkserver`` (POSIX) or ``spawn``: workers start as clean processes that inherit no
-    locks, signal handlers or threads of the caller; the server has imported rotomorph and
-    loaded the solver's kernels once, so every worker it forks starts warm."""
-    import multiprocessing
-
-    if "forkserver" not in multiprocessing.get_all_start_methods():  # pragma: no cover
-        return multiprocessing.get_context("spawn")
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(["rotomorph.sweep._warm"])  # kernels loaded once, forked warm
-    return ctx
-
-
-def _warm_worker(owner: int) -> None:
-    """Pool initializer: Ctrl-C is the owner's to handle (it stops the pool), SIGTERM ends
-    the worker, the worker exits when the owner process (pid ``owner``) is gone, even killed
-    by SIGKILL; then the solver's kernels are loaded before the first run (see ``_warm``)."""
-    import signal
-    import threading
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-    def watch() -> None:
-        while True:
-            time.sleep(1.0)
-            try:
-                os.kill(owner, 0)
-            except ProcessLookupError:
-                os._exit(1)
-            except PermissionError:  # pragma: no cover - pid reused by another user
-                os._exit(1)
-
-    threading.Thread(target=watch, name="rotomorph-owner-watch", daemon=True).start()
-    import rotomorph.sweep._warm  # noqa: F401
-
-
-def _terminate(pool: cf.ProcessPoolExecutor) -> None:
-    """Cancel queued runs and stop the workers now (their runs are not stored: a restart
-    computes them)."""
-    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:
-        terminate()
-        return
-    workers = list((getattr(pool, "_processes", None) or {}).values())  # before shutdown
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in workers:
-        proc.terminate()
-
-
 def _write_plan(store: RunStore, sweep: Sweep) -> None:
     text = json.dumps(sweep.model_dump(mode="json"), indent=2, sort_keys=True)
     atomic_write_text(store.folder / "sweep.json", text + "\n", fsync=store.fsync)
@@ -276,11 +179,15 @@ def run_sweep(
     Raises
     ------
     InvalidParameterError
-        Another sweep holds the folder, the scheduler cannot be reached, or ``chunk < 1``.
+        Another sweep holds the folder, the scheduler cannot be reached or does not answer
+        as a Dask scheduler within :data:`~rotomorph.sweep.executors.HANDSHAKE_TIMEOUT_S`,
+        or ``chunk < 1``.
     """
     if chunk is not None and (isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1):
         raise InvalidParameterError("chunk", f"must be an integer >= 1 or None; got {chunk!r}")
     t0 = time.perf_counter()
+    if scheduler is not None and executor is None:
+        probe_scheduler(scheduler)  # not a Dask scheduler: one line in seconds, no folder made
     points, specs = plan_sweep(sweep)
     unique = {s.run_id: s for s in specs}
     with RunStore(folder, fsync=fsync) as store:
@@ -306,7 +213,7 @@ def run_sweep(
         remote = [s for s in todo if s.error is None]
         lost: list[str] = []
         if remote:
-            with _executor(executor, scheduler, workers) as ex:
+            with open_executor(executor, scheduler, workers) as ex:
                 lost = _drain(ex, evaluate, remote, store_outcome, max(1, max_pending), chunk)
         records = store.finished(unique)
         table = build_table(sweep, points, [s.run_id for s in specs], records)
