@@ -92,21 +92,21 @@ def probe_scheduler(address: str, timeout: float | None = None) -> None:
     def run() -> None:  # its own event loop, also when the caller runs one (a notebook)
         try:
             result["reply"] = asyncio.run(identity())
-        except BaseException as err:  # reported below, in the caller's thread
-            result["error"] = err
+        except BaseException as exc:  # reported below, in the caller's thread
+            result["error"] = exc
 
     thread = threading.Thread(target=run, name="rotomorph-scheduler-probe", daemon=True)
     thread.start()
     thread.join(3 * timeout + 5)
-    err = result.get("error")
-    if thread.is_alive() or isinstance(err, asyncio.TimeoutError | TimeoutError):
+    failure = result.get("error")
+    if thread.is_alive() or isinstance(failure, asyncio.TimeoutError | TimeoutError):
         raise InvalidParameterError(
             "--scheduler",
             f"{address}: no Dask scheduler answered within {timeout:g} s (is this port a "
             f"web server or another service?); {form}",
         )
-    if err is not None:
-        why = " ".join(str(err).split()) or type(err).__name__
+    if failure is not None:
+        why = " ".join(str(failure).split()) or type(failure).__name__
         raise InvalidParameterError(
             "--scheduler", f"cannot reach a Dask scheduler at {address}: {why}; {form}"
         )
