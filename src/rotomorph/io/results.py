@@ -380,58 +380,21 @@ def program_record(program: Any, name: str = "") -> dict[str, Any]:
     }
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
-
-
 def read_results(path: str | os.PathLike[str]) -> RunResults:
-    """Read a file written by :func:`write_results`.
+    """Read and validate a file written by :func:`write_results`, with bounded memory
+    (:func:`rotomorph.io.results_read.read_results`: what is checked and the limits).
 
     Raises
     ------
     InvalidParameterError
-        If the file is not a rotomorph results file or has a newer format version.
+        If the file is not a rotomorph results file, has a newer format version, or is
+        damaged (one line naming the object in the file).
+    OSError
+        The file cannot be opened as HDF5.
     """
-    with h5py.File(path, "r") as h5:
-        if h5.attrs.get("format") != FORMAT:
-            raise InvalidParameterError("path", f"{path} is not a {FORMAT} file")
-        version = int(h5.attrs["format_version"])
-        if version > FORMAT_VERSION:
-            raise InvalidParameterError(
-                "path", f"format version {version} is newer than {FORMAT_VERSION}; upgrade"
-            )
-        units = {"positions": str(h5["steps/positions"].attrs["units"])}
-        scalars, fields = {}, {}
-        for name, ds in h5["steps/scalars"].items():
-            scalars[name] = _frozen(ds[()])
-            units[name] = str(ds.attrs["units"])
-        for name, ds in h5["steps/fields"].items():
-            fields[name] = _frozen(ds[()])
-            units[name] = str(ds.attrs["units"])
-        static = {}
-        for name, ds in h5.get("static", {}).items():
-            static[name] = _frozen(ds[()])
-            units[name] = str(ds.attrs["units"])
-        programs = []
-        for _, pg in sorted(h5.get("programs", {}).items()):
-            prog: dict[str, Any] = {name: _frozen(pg[name][()]) for name in PROGRAM_UNITS}
-            for name, unit in PROGRAM_ATTRS.items():
-                value = pg.attrs[name]
-                prog[name] = float(value) if unit else str(value)
-            programs.append(prog)
-        return RunResults(
-            design=json.loads(h5.attrs["design"]),
-            edges=_frozen(h5["topology/edges"][()].astype(np.int64).reshape(-1, 2)),
-            branch=_frozen(h5["topology/branch"][()].astype(bool)),
-            positions=_frozen(h5["steps/positions"][()]),
-            scalars=scalars,
-            fields=fields,
-            units=units,
-            metadata=json.loads(h5.attrs["metadata"]),
-            static=static,
-            programs=tuple(programs),
-        )
+    from rotomorph.io.results_read import read_results as read_checked
+
+    return read_checked(path)
 
 
 def summarize(results: RunResults) -> dict[str, Any]:
