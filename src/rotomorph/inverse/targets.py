@@ -51,7 +51,7 @@ from rotomorph.errors import InvalidDesignError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
 from rotomorph.io.design_limits import LIMITS
 from rotomorph.io.designfile import ContactModel, Label, as_vector3, schema_error
-from rotomorph.io.tomlfile import read_toml
+from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
 
 __all__ = [
     "BYTES_PER_NODE",
@@ -65,12 +65,13 @@ __all__ = [
     "curve_points",
     "load_target",
     "parse_target",
+    "parse_target_bytes",
 ]
 
 #: Largest designed filament (rod vertices at ``options.spacing`` along the target).
 MAX_CURVE_NODES: Final = 100_000
 #: Most samples of a generated target curve (``samples_per_turn`` × ``turns``).
-MAX_CURVE_SAMPLES: Final = 1_000_000
+MAX_CURVE_SAMPLES: Final = 200_000
 #: Most points of a ``points`` target, and of each axis of a height map.
 MAX_POINTS: Final = 100_000
 MAX_GRID: Final = 1_000
@@ -177,10 +178,11 @@ class HeightMapSpec(_Model):
                 f"z must have len(x) = {len(self.x)} rows of len(y) = {len(self.y)} heights "
                 f"(mm); got {shape}"
             )
+        step = _EXTENT.minimum
         for axis in ("x", "y"):
             v = getattr(self, axis)
-            if any(b <= a for a, b in itertools.pairwise(v)):
-                raise ValueError(f"{axis} must be strictly increasing (mm)")
+            if any(b - a < step for a, b in itertools.pairwise(v)):
+                raise ValueError(f"{axis} must increase by >= {step:g} mm from point to point")
         return self
 
 
@@ -358,6 +360,11 @@ def parse_target(data: dict[str, Any]) -> TargetFile:
     except ValidationError as exc:
         field, msg = _format(exc.errors()[0])
         raise InvalidDesignError(field, msg) from None
+
+
+def parse_target_bytes(data: bytes, name: str = "<target>") -> TargetFile:
+    """Validate the bytes of a TOML target file (as :func:`load_target`, without a file)."""
+    return parse_target(decode_toml_bytes(data, name, InvalidDesignError))
 
 
 def load_target(path: str) -> TargetFile:

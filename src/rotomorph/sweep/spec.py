@@ -44,7 +44,7 @@ from rotomorph.errors import InvalidDesignError, InvalidParameterError
 from rotomorph.io.design_limits import LIMITS
 from rotomorph.io.designfile import Design, FreeText, Label, parse_design, schema_error
 from rotomorph.io.machine import MachineProfile, load_machine_profile
-from rotomorph.io.tomlfile import read_toml
+from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
 from rotomorph.simulate.options import MAX_STEPS, TEMPERATURE_RANGE
 from rotomorph.sweep.paths import check_path, parse_path
 
@@ -59,6 +59,7 @@ __all__ = [
     "Sweep",
     "load_sweep",
     "parse_sweep",
+    "parse_sweep_bytes",
     "sweep_schema",
 ]
 
@@ -403,6 +404,11 @@ def _profile_dict(profile: MachineProfile) -> dict[str, Any]:
     from dataclasses import asdict
 
     return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(profile).items()}
+
+
+def parse_sweep_bytes(data: bytes, name: str = "<sweep>", *, folder: str | Path = ".") -> Sweep:
+    """Validate the bytes of a TOML sweep file (as :func:`load_sweep`, without a file)."""
+    return parse_sweep(decode_toml_bytes(data, name), folder=folder)
 
 
 def load_sweep(path: str | Path) -> Sweep:
