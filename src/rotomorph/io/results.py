@@ -75,6 +75,7 @@ DEFAULT_UNITS: Mapping[str, str] = {
     "stable": "1",
     "lowest_eigenvalue": "N/mm^2",
     "min_clearance": "1",
+    "max_axial_strain": "1",
     "directors": "1",
     "active_normal": "1",
     "twist": "1/mm",

@@ -322,8 +322,8 @@ def _check_metadata(r: _Reader, meta: dict[str, Any], n: int, edges: np.ndarray)
     for key in ("design_name",):
         if key in meta:
             r.check_text(meta[key], f"{where} {key}")
-    if not isinstance(meta.get("contact", False), bool):
-        raise r.fail(f"{where} contact", "must be true or false")
+    if not isinstance(meta.get("contact"), bool | dict | None):
+        raise r.fail(f"{where} contact", "must be a table of the surroundings, or false")
     physical = meta.get("physical", {})
     if not isinstance(physical, dict) or physical.get("verdict", "unknown") not in _VERDICTS:
         raise r.fail(f"{where} physical", "must be {verdict: yes | no | unknown, reason}")

@@ -11,6 +11,11 @@ no two filaments pass through each other. Runs store what they checked as per-st
 ``min_clearance``
     Smallest distance between segments that do not touch as printed, in filament diameters
     (< 1: filaments overlap; without a contact model that is not physical).
+``max_axial_strain``
+    Largest centre-line strain of any edge against its natural length (``|l/l̄ − 1|``). The
+    rod model stretches by a linear, small-strain law; above :data:`MAX_AXIAL_STRAIN` the state
+    is outside the model (a dead load that flipped a filament and pulls it to several times its
+    length converges, and is nonsense). Runs that do not store it are not flagged for it.
 
 A scalar that is missing, or NaN at a step, is **unknown** at that step — never counted as
 fine. Whether contact was modelled is read from ``metadata["contact"]`` (absent: not
@@ -23,13 +28,24 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Final, Literal
 
 import numpy as np
 
-__all__ = ["StepVerdict", "assess", "last_physical_step", "run_verdict", "verdict_record"]
+__all__ = [
+    "MAX_AXIAL_STRAIN",
+    "StepVerdict",
+    "assess",
+    "last_physical_step",
+    "run_verdict",
+    "verdict_record",
+]
 
 Verdict = Literal["yes", "no", "unknown"]
+
+#: Largest centre-line strain against the natural length accepted as physical (20 %): the
+#: stretching law is linear (small strain) and the printed inks are not that extensible.
+MAX_AXIAL_STRAIN: Final = 0.2
 
 
 @dataclass(frozen=True)
@@ -105,6 +121,12 @@ def assess(
             what = "pass through each other" if clear < 0.05 else "overlap"
             failed.append(
                 f"filaments {what} (clearance {clear:.2f} diameters, contact not modelled)"
+            )
+        strain = _flag(scalars, "max_axial_strain", k)
+        if strain > MAX_AXIAL_STRAIN:
+            failed.append(
+                f"edges strained {100 * strain:.0f} % against their natural length (the rod "
+                f"model holds to {100 * MAX_AXIAL_STRAIN:.0f} %)"
             )
         if failed:
             out.append(StepVerdict("no", tuple(failed)))

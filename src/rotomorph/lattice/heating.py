@@ -235,6 +235,9 @@ class HeatingResult:
         Lowest Hessian eigenvalue of each equilibrium (N/mm², see
         :mod:`rotomorph.solve.stability`; NaN for row 0 and when not computed): it drops
         toward 0 where the lattice approaches a bifurcation.
+    max_axial_strain
+        Largest centre-line strain of any edge against its natural length per step (0 for
+        row 0; :attr:`rotomorph.solve.static.StaticResult.max_axial_strain`).
     contact
         The contact settings of the ramp (None: filaments may pass through each other).
     contacts_active
@@ -278,6 +281,7 @@ class HeatingResult:
     states: tuple[State, ...] = ()
     stable: tuple[bool | None, ...] = ()
     lowest_eigenvalue: FloatArray = field(default_factory=lambda: np.zeros(0))
+    max_axial_strain: FloatArray = field(default_factory=lambda: np.zeros(0))
     contact: Contact | None = None
     contacts_active: IntArray | None = None
     floor_lift: FloatArray | None = None
@@ -708,6 +712,7 @@ def heat_lattice(
         states=(lm.model.reference_state(), *(r.state for r in finals)),
         stable=(True, *(_stable_flag(r) for r in finals)),
         lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues[per_step - 1 :: per_step]],
+        max_axial_strain=np.r_[0.0, [getattr(r, "max_axial_strain", np.nan) for r in finals]],
         contact=settings,
         contacts_active=active,
         floor_lift=lift,

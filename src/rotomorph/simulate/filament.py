@@ -106,6 +106,9 @@ class FilamentSimulation:
         The print program simulated.
     lowest_eigenvalue
         ``(S,)`` lowest Hessian eigenvalue of each equilibrium (N/mm²; NaN for step 0).
+    max_axial_strain
+        ``(S,)`` largest centre-line strain against the natural length per step
+        (:attr:`rotomorph.solve.static.StaticResult.max_axial_strain`; 0 for step 0).
     """
 
     name: str
@@ -126,6 +129,7 @@ class FilamentSimulation:
     stable: tuple[bool | None, ...] = ()
     program: Any = None
     lowest_eigenvalue: FloatArray = field(default_factory=lambda: np.zeros(0))
+    max_axial_strain: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def final_ratio(self) -> float:
@@ -379,6 +383,7 @@ def simulate_filament(
         stable=stable,
         program=program,
         lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues],
+        max_axial_strain=np.r_[0.0, [step.result.max_axial_strain for step in path.steps]],
     )
 
 

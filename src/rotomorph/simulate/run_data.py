@@ -197,20 +197,25 @@ def _filament_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, 
             directors[:, segs], normals[:, segs] = m1, nn
         clearance[i] = chain_clearance(fil.positions, 2.0 * program.radius)
     scalars = {"stable": _combine(stable), "min_clearance": _combine(clearance)}
+    strains = [np.asarray(getattr(f, "max_axial_strain", ()), dtype=float) for f in sim.filaments]
+    if strains and all(len(v) == sim.positions.shape[0] for v in strains):
+        scalars["max_axial_strain"] = np.max(np.stack(strains), axis=0)
     eig = [np.asarray(getattr(f, "lowest_eigenvalue", ()), dtype=float) for f in sim.filaments]
     if eig and all(len(v) == sim.positions.shape[0] for v in eig):
         with np.errstate(all="ignore"):
             scalars["lowest_eigenvalue"] = np.min(np.stack(eig), axis=0)
     fields = {"directors": directors, "active_normal": normals}
-    per_filament = [
-        {
-            "min_clearance_diameters": float(c[-1]) if np.isfinite(c[-1]) else None,
-            "physical": verdict_record(
-                assess({"converged": np.ones(len(c)), "stable": st, "min_clearance": c}, {}, len(c))
-            ),
-        }
-        for c, st in zip(clearance, stable, strict=True)
-    ]
+    per_filament = []
+    for i, (c, st) in enumerate(zip(clearance, stable, strict=True)):
+        flags = {"converged": np.ones(len(c)), "stable": st, "min_clearance": c}
+        if len(strains[i]) == len(c):
+            flags["max_axial_strain"] = strains[i]
+        per_filament.append(
+            {
+                "min_clearance_diameters": float(c[-1]) if np.isfinite(c[-1]) else None,
+                "physical": verdict_record(assess(flags, {}, len(c))),
+            }
+        )
     return static, fields, scalars, programs, [chains, per_filament]
 
 
@@ -249,6 +254,9 @@ def _lattice_extras(sim: Any, n: int, e: int) -> tuple[dict, dict, dict, list, l
     )
     programs = [program_record(p, f"layer {p.layer}") for p in lattice.print_programs()]
     scalars = {"stable": stable}
+    strain = np.asarray(getattr(res, "max_axial_strain", ()), dtype=float)
+    if len(strain) == sim.positions.shape[0]:
+        scalars["max_axial_strain"] = strain
     eig = np.asarray(getattr(res, "lowest_eigenvalue", ()), dtype=float)
     if len(eig) == sim.positions.shape[0]:
         scalars["lowest_eigenvalue"] = eig

@@ -56,6 +56,12 @@ class StaticResult:
         Their mode shapes when ``NewtonOptions.keep_modes`` is set, else None.
     escapes
         Steps the solver took off unstable equilibria (saddles) on the way.
+    max_axial_strain
+        Largest ``|l / l̄ − 1|`` over the edges: stretch or shortening of the centre line
+        against its natural (rest) length. The rod model's stretching law is a small-strain
+        law; a state far beyond a few per cent (e.g. a compressive dead load that flipped the
+        rod and now pulls it to several times its length) is not physical
+        (:mod:`rotomorph.io.validity` flags it).
     """
 
     state: State
@@ -70,6 +76,7 @@ class StaticResult:
     eigenvalues: FloatArray = field(default_factory=lambda: np.zeros(0))
     modes: Modes | None = None
     escapes: int = 0
+    max_axial_strain: float = 0.0
 
     @property
     def positions(self) -> FloatArray:
@@ -146,7 +153,17 @@ def solve_static(
         eigenvalues=res.eigenvalues,
         modes=None if res.modes is None else mode_fields(obj, res.modes),
         escapes=res.escapes,
+        max_axial_strain=max_axial_strain(model, final),
     )
+
+
+def max_axial_strain(model: Model, state: State) -> float:
+    """Largest ``|l / l̄ − 1|`` over the edges of ``state`` (l̄: the model's rest lengths)."""
+    pos = np.asarray(state.positions)
+    edges = model.network.edges
+    length = np.linalg.norm(pos[edges[:, 1]] - pos[edges[:, 0]], axis=1)
+    rest = np.asarray(model.rest_length, dtype=float)
+    return float(np.max(np.abs(length / rest - 1.0))) if len(rest) else 0.0
 
 
 _HINTS = {
