@@ -352,8 +352,13 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     if out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: is a folder; give a file name")
     _check_writable(out, create_parent=False, inputs=[Path(args.design)])
-    if not (args.cure >= 0 and math.isfinite(args.cure)):
-        raise UsageError(f"--cure: must be a UV dwell in seconds >= 0; got {args.cure:g}")
+    from rotomorph.io.design_limits import MAX_LAYER_CURE_S
+
+    if not (0 <= args.cure <= MAX_LAYER_CURE_S and math.isfinite(args.cure)):
+        raise UsageError(
+            f"--cure: must be a UV dwell per layer in [0, {MAX_LAYER_CURE_S:g}] s; got "
+            f"{args.cure:g} s"
+        )
     machine = _machine(args)
     programs = design.to_programs()
     _check_materials(programs)

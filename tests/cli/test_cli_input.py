@@ -100,14 +100,20 @@ def test_validate_checks_a_machine_like_gcode(tmp_path, capsys):
     assert "max_feed" in _error(capsys)
 
 
-@pytest.mark.parametrize("cure", ["-5", "nan", "inf"])
-def test_gcode_cure_must_be_a_finite_dwell(tmp_path, capsys, cure):
-    # before: "layer_cure_s: must be >= 0 s; got nan" (a library argument, not the flag)
+@pytest.mark.parametrize("cure", ["-5", "nan", "inf", "1e9", "3600.5"])
+def test_gcode_cure_must_be_a_dwell_within_an_hour(tmp_path, capsys, cure):
+    # before: "layer_cure_s: must be >= 0 s; got nan" (a library argument, not the flag), and
+    # --cure 1e9 (32 years of dwell per layer) was written
     out = tmp_path / "x.gcode"
     argv = ["gcode", str(_write(tmp_path, FILAMENT)), "-o", str(out), "--cure", cure]
     assert main(argv) == EXIT_USAGE
-    assert _error(capsys) == f"--cure: must be a UV dwell in seconds >= 0; got {float(cure):g}"
+    assert _error(capsys) == (
+        f"--cure: must be a UV dwell per layer in [0, 3600] s; got {float(cure):g} s"
+    )
     assert not out.exists()
+    argv[-1] = "3600"
+    assert main(argv) == EXIT_OK and "G4 P3600" in out.read_text()
+    capsys.readouterr()
 
 
 @pytest.mark.parametrize(

@@ -33,6 +33,7 @@ from rotomorph.inverse.simplify import (
 )
 from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
+from rotomorph.io.design_limits import FILAMENT_PER_NOZZLE, nozzle_for
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
 from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
 
@@ -131,6 +132,9 @@ def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Desig
             }
         ],
     }
+    lo, hi = FILAMENT_PER_NOZZLE
+    if not lo <= 2 * prog.radius <= hi:  # the default 1 mm nozzle cannot print this filament
+        data["nozzle"] = {"diameter": nozzle_for(float(prog.radius))}
     return parse_design(data)
 
 

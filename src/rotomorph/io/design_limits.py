@@ -20,12 +20,16 @@ from typing import Final
 
 __all__ = [
     "BYTES_PER_NODE",
+    "FILAMENT_PER_NOZZLE",
     "LIMITS",
+    "MAX_LAYER_CURE_S",
     "MAX_NODES",
     "SETUP_S_PER_NODE",
+    "TYPICAL_FILAMENT_PER_NOZZLE",
     "Limit",
     "SizeEstimate",
     "lattice_nodes",
+    "nozzle_for",
     "segment_edges",
     "sinusoid_length",
 ]
@@ -38,6 +42,25 @@ BYTES_PER_NODE: Final = 20_000  # 19.8 kB/node at 18 300 nodes (30 x 30 lattice)
 #: 40 µs/node CPU measured for a 100 x 100 lattice (benchmarks/lattice_setup.py), with margin
 #: for a busy machine.
 SETUP_S_PER_NODE: Final = 6e-5
+
+
+#: Longest UV-cure dwell per layer (s) that ``gcode --cure`` writes: an hour, as the design
+#: file's dwells (``prime_dwell``, ``release_dwell``); 1e9 s would be 32 years of dwell.
+MAX_LAYER_CURE_S: Final = 3600.0
+
+#: Accepted printed filament diameter 2R per nozzle diameter: drawing (printing faster than the
+#: ink leaves the nozzle) thins a filament, swelling thickens it; outside this band the pair
+#: cannot be printed (a 10 mm filament from a 0.1 mm nozzle).
+FILAMENT_PER_NOZZLE: Final = (0.2, 2.0)
+#: What the paper prints: 0.6 mm filaments from its 1 mm nozzle, 0.3 mm from 0.5 mm.
+TYPICAL_FILAMENT_PER_NOZZLE: Final = 0.6
+
+
+def nozzle_for(radius: float) -> float:
+    """A nozzle diameter (mm) that prints filaments of ``radius`` (mm) at the paper's ratio,
+    within the nozzle's range."""
+    lo, hi = 0.01, 10.0  # LIMITS["nozzle_diameter"]
+    return float(min(max(round(2.0 * radius / TYPICAL_FILAMENT_PER_NOZZLE, 4), lo), hi))
 
 
 @dataclass(frozen=True)

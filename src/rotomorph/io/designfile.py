@@ -79,10 +79,12 @@ from rotomorph.design.program import PrintProgram, active_side_angle
 from rotomorph.errors import InvalidDesignError, MaterialError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.design_limits import (
+    FILAMENT_PER_NOZZLE,
     LIMITS,
     MAX_NODES,
     SizeEstimate,
     lattice_nodes,
+    nozzle_for,
     segment_edges,
     sinusoid_length,
 )
@@ -716,6 +718,26 @@ class Design(_Model):
         refusal = design_size(self).refusal()
         if refusal:
             raise ValueError(f"{refusal} over all filaments; split the design or increase spacing")
+        return self
+
+    @model_validator(mode="after")
+    def _nozzle_fits(self) -> Design:
+        """The printed diameter 2R must come out of the nozzle: within
+        :data:`~rotomorph.io.design_limits.FILAMENT_PER_NOZZLE` nozzle diameters."""
+        lo, hi = FILAMENT_PER_NOZZLE
+        d = self.nozzle.diameter
+        owners = [(f"filaments[{i}].radius", f.radius) for i, f in enumerate(self.filaments)]
+        if self.lattice is not None:
+            owners.append(("lattice.radius", self.lattice.radius))
+        for where, radius in owners:
+            if not lo * d <= 2 * radius <= hi * d:
+                raise ValueError(
+                    f"{where} = {radius:g} mm is a {2 * radius:g} mm filament, which a "
+                    f"{d:g} mm nozzle cannot print: the filament diameter must lie within "
+                    f"{lo:g}-{hi:g} nozzle diameters ({lo * d:g}-{hi * d:g} mm; the paper's 1 mm "
+                    f"nozzle prints 0.6 mm filaments); set nozzle.diameter = "
+                    f"{nozzle_for(radius):g} or change the radius"
+                )
         return self
 
     def to_programs(self) -> list[PrintProgram]:
