@@ -42,7 +42,7 @@ def test_a_points_target_from_toml_designs_a_filament(tmp_path, capsys):
     [
         ("turns = 1e9", "curve.turns", "must be <= 10000"),
         ("turns = 5000.0\nsamples_per_turn = 2000", "curve", "10,000,000 samples"),
-        ("turns = 5000.0\n[options]\nspacing = 0.001", "<target>", "filament vertices"),
+        ("turns = 1000.0\n[options]\nspacing = 0.001", "<target>", "filament vertices"),
         ("turns = 2.0\nradius_start = 1e300", "curve.radius_start", "must be <= 10000"),
     ],
 )

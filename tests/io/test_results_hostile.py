@@ -258,3 +258,12 @@ def test_the_valid_file_plots_and_views(valid, tmp_path, capsys):
     assert main(["plot", str(path), "-o", str(tmp_path / "figs"), "--no-movie"]) == EXIT_OK
     assert main(["view", str(path), "--no-open"]) == EXIT_OK
     capsys.readouterr()
+
+
+@pytest.mark.parametrize("contact", [None, False, {"self_contact": True, "floor": False}])
+def test_every_contact_record_a_run_writes_is_read(valid, tmp_path, contact):
+    path = tmp_path / "results.h5"
+    shutil.copyfile(valid, path)
+    with h5py.File(path, "r+") as h5:
+        _meta(h5, lambda m: m.update(contact=contact, kind="filaments"))
+    assert read_results(path).metadata["contact"] == contact
