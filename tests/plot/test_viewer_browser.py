@@ -73,13 +73,14 @@ def _tamper_field_names(run: Path) -> str:
     return name
 
 
-def _open(html: Path) -> dict:
-    """Open ``html`` in headless Chromium; return what the rendered page holds."""
+def _open(html: Path, chromium: str) -> dict:
+    """Open ``html`` in headless Chromium (the executable ``chromium``); return what the
+    rendered page holds."""
     from playwright.sync_api import sync_playwright
 
     dialogs: list[str] = []
     with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        browser = pw.chromium.launch(executable_path=chromium, args=CHROMIUM_ARGS)
         try:
             page = browser.new_page()
             page.on("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
@@ -121,12 +122,12 @@ def _assert_nothing_renders_as_markup(found: dict, expected: list[str]) -> None:
 
 
 def test_view_html_shows_markup_in_names_literally(tmp_path, require_tool):
-    require_tool("chromium", "apt-get install chromium")
+    chromium = require_tool("chromium", "apt-get install chromium")
     design = _design(tmp_path)
     run = tmp_path / "run"
     assert main(["simulate", str(design), "-o", str(run), "--steps", "2", "--no-movie"]) == 0
     assert main(["view", str(run), "--no-open"]) == EXIT_OK
-    found = _open(run / "view.html")
+    found = _open(run / "view.html", chromium)
     _assert_nothing_renders_as_markup(found, list(PAYLOADS.values()))
     stored = json.loads((run / "summary.json").read_text())
     assert stored["metadata"]["design_name"] == PAYLOADS["design"]  # kept as written
@@ -134,4 +135,4 @@ def test_view_html_shows_markup_in_names_literally(tmp_path, require_tool):
     name = _tamper_field_names(run)
     out = tmp_path / "field.html"
     assert main(["view", str(run), "--no-open", "--field", name, "-o", str(out)]) == EXIT_OK
-    _assert_nothing_renders_as_markup(_open(out), [f"{name} ({UNIT})", PAYLOADS["f1"]])
+    _assert_nothing_renders_as_markup(_open(out, chromium), [f"{name} ({UNIT})", PAYLOADS["f1"]])

@@ -145,7 +145,8 @@ def command(args: argparse.Namespace) -> int:
     if result.lost:
         sys.stderr.write(
             f"rotomorph: error: {len(result.lost)} run(s) lost to a failed worker "
-            f"(first: {result.lost[0]}); run the same command again to finish them\n"
+            f"(first: {terminal_safe(result.lost[0])}); run the same command again to finish "
+            "them\n"
         )
         return 1
     return 0
