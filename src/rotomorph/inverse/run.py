@@ -33,7 +33,7 @@ from rotomorph.inverse.simplify import (
 )
 from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
-from rotomorph.io.design_limits import FILAMENT_PER_NOZZLE, nozzle_for
+from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
 from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
 
@@ -132,9 +132,7 @@ def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Desig
             }
         ],
     }
-    lo, hi = FILAMENT_PER_NOZZLE
-    if not lo <= 2 * prog.radius <= hi:  # the default 1 mm nozzle cannot print this filament
-        data["nozzle"] = {"diameter": nozzle_for(float(prog.radius))}
+    data.update(nozzle_table(float(prog.radius)))  # when the default nozzle cannot print it
     return parse_design(data)
 
 

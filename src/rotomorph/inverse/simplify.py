@@ -39,6 +39,7 @@ from rotomorph._typing import FloatArray
 from rotomorph.inverse.curve import curve_geometry
 from rotomorph.inverse.filament import FilamentDesign, kabsch
 from rotomorph.inverse.response import ResponseTable
+from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import Design, parse_design
 from rotomorph.materials.natural import FilamentModel, natural_field
 from rotomorph.rod.model import Model
@@ -362,6 +363,7 @@ def _design_file(
                     ],
                 }
             ],
+            **nozzle_table(radius),  # when the default 1 mm nozzle cannot print the filament
         }
     )
 

@@ -30,6 +30,7 @@ __all__ = [
     "SizeEstimate",
     "lattice_nodes",
     "nozzle_for",
+    "nozzle_table",
     "segment_edges",
     "sinusoid_length",
 ]
@@ -61,6 +62,13 @@ def nozzle_for(radius: float) -> float:
     within the nozzle's range."""
     lo, hi = 0.01, 10.0  # LIMITS["nozzle_diameter"]
     return float(min(max(round(2.0 * radius / TYPICAL_FILAMENT_PER_NOZZLE, 4), lo), hi))
+
+
+def nozzle_table(radius: float) -> dict[str, dict[str, float]]:
+    """``{"nozzle": {"diameter": …}}`` for a design file whose filaments of ``radius`` (mm) the
+    default 1 mm nozzle cannot print, else ``{}`` (see :data:`FILAMENT_PER_NOZZLE`)."""
+    lo, hi = FILAMENT_PER_NOZZLE
+    return {} if lo <= 2 * radius <= hi else {"nozzle": {"diameter": nozzle_for(radius)}}
 
 
 @dataclass(frozen=True)
