@@ -112,7 +112,7 @@ def test_gcode_cure_must_be_a_dwell_within_an_hour(tmp_path, capsys, cure):
     )
     assert not out.exists()
     argv[-1] = "3600"
-    assert main(argv) == EXIT_OK and "G4 P3600" in out.read_text()
+    assert main(argv) == EXIT_OK and "3600 s" in out.read_text()
     capsys.readouterr()
 
 

@@ -1,6 +1,6 @@
 """An equilibrium whose edges are stretched far beyond the rod model's small-strain law is
 flagged as not physical in every output (a dead load that flips a filament and pulls it to
-eight times its length converges, and is nonsense)."""
+several times its length converges, and is nonsense)."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def test_the_axial_strain_of_a_pulled_rod_is_force_over_stiffness():
 def test_an_absurd_stretch_is_not_physical_in_every_output(tmp_path):
     prog = _program()
     sim = simulate_filament(prog, steps=2, loads=_pull(len(prog.points), 3.0))
-    assert sim.max_axial_strain[-1] > 5.0  # it converged: eight times its natural length
+    assert sim.max_axial_strain[-1] > 2.0  # it converged, at several times its natural length
     run = describe_run(as_run(sim))
     assert run.scalars["max_axial_strain"][-1] > MAX_AXIAL_STRAIN
     verdict = run.metadata["physical"]

@@ -140,3 +140,13 @@ def test_check_record_names_the_reason(finished):
     assert rec["record_format"] == 1 and len(rec["checksum"]) == 64
     with pytest.raises(DamagedRecord, match=r"belongs to run .* \(copied\?\)"):
         check_record(store.record_path(run_id), "0" * 64)
+
+
+def test_overlapping_runs_give_the_library_logger_its_propagation_back(tmp_path):
+    """Runs in threads silence the library's logger while they run; when all have ended it
+    propagates again (it stayed silent when two runs' save/restore interleaved)."""
+    logger = logging.getLogger("rotomorph")
+    assert logger.propagate
+    for _ in range(3):
+        _run(_sweep(method="rod"), tmp_path / "out")
+        assert logger.propagate

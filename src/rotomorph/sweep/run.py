@@ -231,19 +231,33 @@ class _Collect(logging.Handler):
                 self.messages.append(msg)
 
 
+_QUIET_LOCK = threading.Lock()
+_QUIET = {"runs": 0, "propagate": True}
+
+
 @contextlib.contextmanager
 def _captured_warnings() -> Iterator[list[str]]:
-    """Collect the library's warnings of this run (kept in its record, not printed)."""
+    """Collect the library's warnings of this run (kept in its record, not printed).
+
+    Runs may overlap in one process (a thread pool, Dask's threads): the library logger stops
+    propagating while any run is active and gets its own setting back when the last one ends
+    (saving and restoring it per run would leave it off when two runs interleave)."""
     logger = logging.getLogger("rotomorph")
     handler = _Collect()
-    propagate = logger.propagate
+    with _QUIET_LOCK:
+        if _QUIET["runs"] == 0:
+            _QUIET["propagate"] = logger.propagate
+            logger.propagate = False
+        _QUIET["runs"] += 1
     logger.addHandler(handler)
-    logger.propagate = False
     try:
         yield handler.messages
     finally:
         logger.removeHandler(handler)
-        logger.propagate = propagate
+        with _QUIET_LOCK:
+            _QUIET["runs"] -= 1
+            if _QUIET["runs"] == 0:
+                logger.propagate = bool(_QUIET["propagate"])
 
 
 def execute_run(spec: RunSpec) -> RunOutcome:
