@@ -10,9 +10,27 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.errors import InvalidParameterError
-from rotomorph.lattice.heating import heat_lattice, lattice_gravity
+from rotomorph.lattice.heating import (
+    RAMP_OPTIONS,
+    heat_lattice,
+    lattice_gravity,
+    perturbed_state,
+    symmetry_breaking,
+)
+from rotomorph.lattice.model import lattice_model
+from rotomorph.lattice.published import (
+    FRICTION,
+    GRAVITY,
+    LOGGED_STRETCH,
+    YOUNGS_MODULUS,
+    published_actuation,
+    published_gravity,
+    published_lattice,
+)
+from rotomorph.solve.static import solve_static
 
 ACT = "swapped"  # the paper's in-plane curvature scaling: the flat state is an equilibrium
 
@@ -69,15 +87,83 @@ def test_a_perfectly_flat_dome_on_the_floor_still_rises(dome):
     assert flat.first_lift_off() is not None
 
 
-@pytest.mark.parametrize(
-    "kw", [{"supports": "pinned-centre"}, {"friction": 0.3}], ids=["supported", "friction"]
-)
-def test_no_probe_where_it_would_move_supports_or_compare_dissipation(kw):
-    """The probe moves the lattice rigidly and compares total energies: not with supports
-    (they would move) nor with lagged friction (not a potential); those ramps are continuous."""
+def test_no_probe_where_it_would_move_supports():
+    """The probe moves the lattice rigidly: not with supports (they would move with it); such
+    ramps are continuous."""
     lat = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="dome")
-    res = heat_lattice(lat, actuation=ACT, steps=1, floor=True, gravity=lattice_gravity(lat), **kw)
+    res = heat_lattice(
+        lat,
+        actuation=ACT,
+        steps=1,
+        floor=True,
+        gravity=lattice_gravity(lat),
+        supports="pinned-centre",
+    )
     assert res.lift_energy_gap is None
+
+
+def test_the_probe_runs_with_friction():
+    """With friction the probe compares potential energies (lagged friction left out of
+    both), so a ramp with friction looks for a lifted state too (it did not before)."""
+    lat = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="dome")
+    res = heat_lattice(
+        lat, actuation=ACT, steps=1, floor=True, gravity=lattice_gravity(lat), friction=0.3
+    )
+    assert res.lift_energy_gap is not None and res.lift_energy_gap.shape == (2,)
+
+
+#: A weight 1000 times below the authors' logged one (w l³/B ≈ 1e-5): negligible.
+NEGLIGIBLE = 1e-3 * GRAVITY
+
+
+@pytest.fixture(scope="module")
+def authors_free_saddle():
+    """The authors' lattice at their logged stretch, weightless, away from any floor."""
+    lat = published_lattice()
+    lm = lattice_model(lat, stiffness="paper", youngs_modulus=YOUNGS_MODULUS)
+    model = published_actuation(0.0, LOGGED_STRETCH).natural(lm, LOGGED_STRETCH)
+    bump = symmetry_breaking(lat, 1e-2 * lat.spacing, 0)
+    return solve_static(model, initial=perturbed_state(lm.model, bump), options=RAMP_OPTIONS)
+
+
+@pytest.mark.parametrize("friction", [0.0, FRICTION], ids=["frictionless", "friction 0.4"])
+def test_the_authors_saddle_leaves_the_floor_where_it_is_lower(friction, authors_free_saddle):
+    """The authors' saddle set-up (their lattice, edge lists, stretch -0.17, E = 2e11 Pa, their
+    floor friction 0.4) under a negligible weight: the flat state on the floor is a strict
+    local minimum (the continuous branch stays there), but the free saddle is ~15 % lower in
+    total energy and nothing holds it down, so the lowest branch must take it. The probe used
+    to give up when the weightless buckling ran out of Newton iterations (about 430 are needed
+    from the flat state), and did not run at all with friction."""
+    lat = published_lattice()
+    kw = dict(
+        actuation=published_actuation(0.0, LOGGED_STRETCH),
+        steps=1,
+        stiffness="paper",
+        youngs_modulus=YOUNGS_MODULUS,
+        floor=True,
+        friction=friction,
+        gravity=published_gravity(NEGLIGIBLE),
+    )
+    res = heat_lattice(lat, **kw)
+    assert res.gaussian_sign[-1] == -1 and res.stable[-1] is True
+    assert res.floor_lift[-1] > 2.0 * lat.radius
+    # it is the free saddle (an independent solve: no floor, no weight, no probe), resting on
+    # the floor on a few points
+    assert res.energy[-1] == pytest.approx(authors_free_saddle.energy, rel=2e-3)
+    assert res.characteristic_curvature[-1] == pytest.approx(
+        fit_quadratic_surface(
+            authors_free_saddle.positions[lat.branch_indices]
+        ).characteristic_curvature,
+        rel=1e-2,
+    )
+    gap = res.lift_energy_gap[-1]
+    resting = res.energy[-1] - gap
+    assert -0.16 < gap / resting < -0.13  # ~15 % lower than resting flat
+    if not friction:
+        flat = heat_lattice(lat, branch="continuous", **kw)
+        assert flat.gaussian_sign[-1] == 0 and flat.stable[-1] is True
+        assert flat.floor_lift[-1] < 2.0 * lat.radius
+        assert flat.energy[-1] == pytest.approx(resting, rel=1e-9)
 
 
 def test_lift_off_and_weightless_buckling_are_bisected_and_ordered(dome, ramps):

@@ -46,7 +46,7 @@ from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 
-from rotomorph._typing import FloatArray, IntArray
+from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
@@ -118,11 +118,17 @@ class CurvatureScaling:
         ``"literal"``, ``"swapped"`` or ``"radius"`` (module table).
     start, end
         Ramp of x (dimensionless); the paper ramps 0 → 0.75. ``radius`` needs x < 1.
+    fixed_edges
+        Lattice edges (indices into ``lattice.edge_nodes``) whose rod vertices keep their
+        printed curvature at every x: edges in neither class. Default none. (The authors'
+        published simulation of Fig. 4 leaves two boundary edges out of both of its edge
+        lists: :mod:`rotomorph.lattice.published`.)
     """
 
     reading: Literal["literal", "swapped", "radius"] = "swapped"
     start: float = 0.0
     end: float = PAPER_FINAL_X
+    fixed_edges: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
         if self.reading not in ("literal", "swapped", "radius"):
@@ -135,6 +141,14 @@ class CurvatureScaling:
             raise InvalidParameterError(
                 "CurvatureScaling.end", "must be < 1 for the 'radius' reading (κ0/(1 − x))"
             )
+        fixed = tuple(self.fixed_edges)
+        for k, e in enumerate(fixed):
+            if isinstance(e, bool) or int(e) != e or e < 0:
+                raise InvalidParameterError(
+                    f"CurvatureScaling.fixed_edges[{k}]",
+                    f"must be a lattice edge index (an integer >= 0); got {e!r}",
+                )
+        object.__setattr__(self, "fixed_edges", tuple(int(e) for e in fixed))
 
     @property
     def name(self) -> str:
@@ -153,8 +167,29 @@ class CurvatureScaling:
         """Scaled printed curvature on rod vertices, printed values on junction pairs."""
         c_exp, c_con = self.factors(float(parameter))
         c = np.where(lm.expanding, c_exp, np.where(lm.rod_vertex, c_con, 1.0))
+        if self.fixed_edges:
+            c = np.where(_on_edges(lm, self.fixed_edges), 1.0, c)
         k1, k2, _ = lm.printed
         return lm.model.with_natural(curvature1=c * k1, curvature2=c * k2)
+
+
+def _on_edges(lm: LatticeModel, edges: tuple[int, ...]) -> BoolArray:
+    """``(S,)`` True on the rod vertices of lattice edges ``edges`` (junction pairs never).
+
+    A rod vertex joins two segments of one lattice edge; the network's segments run in chain
+    order along each edge, in edge order, ``ghost_nodes + 1`` per edge.
+    """
+    n_edges = len(lm.lattice.edge_nodes)
+    bad = [e for e in edges if e >= n_edges]
+    if bad:
+        raise InvalidParameterError(
+            "CurvatureScaling.fixed_edges",
+            f"must be lattice edges in [0, {n_edges - 1}]; got {bad}",
+        )
+    per = lm.lattice.ghost_nodes + 1
+    segments = np.arange(lm.model.network.n_edges) if lm.segments is None else lm.segments
+    edge_of = np.asarray(segments)[lm.model.stencils.edge_e] // per
+    return np.asarray(lm.rod_vertex & np.isin(edge_of, edges))
 
 
 def _janus_curvature(lm: LatticeModel, fm: FilamentModel) -> tuple[float, float]:

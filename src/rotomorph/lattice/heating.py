@@ -62,6 +62,8 @@ from rotomorph.rod.state import State
 from rotomorph.solve.continuation import ContinuationResult, continuation
 from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.objective import RodObjective
+from rotomorph.solve.result import Status
 from rotomorph.solve.stability import StabilityResult, stability
 from rotomorph.solve.static import StaticResult, solve_static
 
@@ -427,6 +429,7 @@ def heat_lattice(
     branch: Literal["lowest", "continuous"] = "lowest",
     lift_off_tolerance: float | None = None,
     path_check: int = 1,
+    youngs_modulus: float | None = None,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -484,8 +487,9 @@ def heat_lattice(
         starts along that mode and keep the equilibrium of lower total energy — the state an
         imperfect real lattice, disturbed as it is moved into the hot bath, can settle in
         (:func:`_lift_probe`; ``lift_energy_gap`` records the comparison). The probe runs only
-        for free lattices without friction (it moves the lattice rigidly, and lagged friction
-        is not a potential to compare); otherwise the ramp is continuous.
+        for free lattices (it moves the lattice rigidly; with supports the ramp is
+        continuous); with friction it compares potential energies, friction's lagged
+        dissipation left out of both.
     lift_off_tolerance
         With ``branch="lowest"``: where the lattice leaves the floor, bisect the ramp
         parameter to this width for the lift-off (the first lifted equilibrium lower in
@@ -500,6 +504,11 @@ def heat_lattice(
         (:mod:`rotomorph.lattice.paths`; ``HeatingResult.path_check`` records it). A kept
         sub-stepped ramp is sampled at the requested steps (its sub-steps' iterations count
         toward them). Default 1: no check.
+    youngs_modulus
+        E (MPa) of the ``"paper"`` stiffness (:func:`~rotomorph.lattice.model.lattice_model`;
+        default :func:`~rotomorph.lattice.model.paper_modulus`). Unloaded shapes do not depend
+        on it; under a weight or in contact it sets the bending scale the weight is measured
+        against.
 
     Returns
     -------
@@ -529,7 +538,9 @@ def heat_lattice(
         f"{lattice.network.n_nodes:,}",
         stiffness,
     )
-    lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
+    lm = lattice_model(
+        lattice, stiffness=stiffness, filament_model=fm, youngs_modulus=youngs_modulus
+    )
 
     def loads_at(p: float) -> Loads:
         return Loads(gravity=gravity(p) if callable(gravity) else gravity)
@@ -552,15 +563,11 @@ def heat_lattice(
         )
     if branch not in ("lowest", "continuous"):
         raise InvalidParameterError("branch", f"must be 'lowest' or 'continuous'; got {branch!r}")
-    # the probe moves the lattice rigidly (supports would move with it) and compares total
-    # energies (lagged friction is dissipation, not a potential): free, frictionless only
+    # the probe moves the lattice rigidly (supports would move with it): free lattices only;
+    # with friction it compares potential energies (_lift_probe)
     probe_floor = (
         settings.floor
-        if branch == "lowest"
-        and settings is not None
-        and gravity is not None
-        and sup.is_free
-        and not settings.friction
+        if branch == "lowest" and settings is not None and gravity is not None and sup.is_free
         else None
     )
     factor = check_factor(path_check)
@@ -753,6 +760,14 @@ LIFT_PROBE_HEIGHT = 0.1
 #: 146 iterations; 62 at this softening, and the same lifted state).
 SEARCH_SOFTENING = 0.01
 
+#: Newton solves (each up to the ramp's iteration limit) the weightless buckling solve of
+#: :func:`_lift_probe` may take: one that runs out of iterations is continued from its last
+#: iterate, since it only looks for a shape. Buckling a very slender lattice from its flat
+#: state is a long Newton path: the authors' Fig. 4 lattice (r/l = 0.001,
+#: :mod:`rotomorph.lattice.published`) takes about 430 iterations to its saddle at stretch
+#: -0.17, beyond the ramp's 300, and a probe that gave up there kept it flat.
+SEARCH_SOLVES = 4
+
 
 def _lift_probe(
     model: Model,
@@ -790,6 +805,15 @@ def _lift_probe(
     result is returned only if it is certified stable, lower in total energy (elastic +
     weight + barrier) and actually off the floor. A lift found inside a halved or path-check
     sub-step is recorded in the row of the step it leads to (``_gaps_per_step``).
+
+    With friction the comparison is between potential energies (elastic + weight + barrier):
+    lagged friction is dissipation, not a potential, so it is left out of both. The lifted
+    candidates settle on a frictionless floor (whether a lifted state lower in potential
+    energy exists does not depend on friction; an equilibrium of the frictionless problem is
+    one of the frictional problem lagged at itself, where friction carries no force), the
+    resting state's potential energy is evaluated without its friction term, and the lifted
+    state taken is solved once more with the ramp's friction, lagged at itself, so that the
+    ramp goes on from an equilibrium of its own problem.
     """
     diameter = 2.0 * lattice.radius
     if _rise(floor, lattice, resting.positions) > diameter:
@@ -800,29 +824,29 @@ def _lift_probe(
     v = modes.modes.displacements[0][:, 2]
     if float(np.ptp(v)) == 0.0:
         return None, None, 0
-    spent = 0
+    # the candidates settle on a frictionless floor; with friction the resting state is
+    # compared by its potential energy (docstring)
+    frictional = bool(settings.friction)
+    on_floor = replace(settings, friction=0.0) if frictional else settings
+    rest_energy = (
+        _potential_energy(model, supports, loads, on_floor, resting.state)
+        if frictional
+        else resting.energy
+    )
     # 1. the weightless lattice away from the floor buckles from the flat state along the mode
     afloat = replace(
         settings,
         obstacles=tuple(o for o in settings.obstacles if o is not floor),
         stiffness=None if settings.stiffness is None else SEARCH_SOFTENING * settings.stiffness,
         stiffness_scale=SEARCH_SOFTENING * settings.stiffness_scale,
+        friction=0.0,
     )
     dz = v * (LIFT_PROBE_HEIGHT * lattice.spacing / float(np.abs(v).max()))
-    try:
-        free = solve_static(
-            model,
-            supports,
-            Loads(),
-            initial=perturbed_state(model, dz, resting.state),
-            options=options,
-            contact=afloat,
-        )
-    except (ConvergenceError, InfeasibleContactError) as err:
-        its = int(getattr(getattr(err, "result", None), "iterations", 0))
-        phase_log.debug("lift probe: the weightless lattice did not settle (%d its)", its)
-        return None, None, its
-    spent += free.iterations
+    free, spent = _settle_weightless(
+        model, supports, perturbed_state(model, dz, resting.state), options, afloat
+    )
+    if free is None:
+        return None, None, spent
     # 2. laid on the floor either way up, it settles under its weight
     best: StaticResult | None = None
     gap_floor = float(floor.height_of(resting.positions).min())
@@ -834,7 +858,7 @@ def _lift_probe(
         start = _laid_on(free.state, floor, gap_floor, flip, weight)
         try:
             trial = solve_static(
-                model, supports, loads, initial=start, options=options, contact=settings
+                model, supports, loads, initial=start, options=options, contact=on_floor
             )
         except (ConvergenceError, InfeasibleContactError) as err:
             spent += int(getattr(getattr(err, "result", None), "iterations", 0))
@@ -847,15 +871,67 @@ def _lift_probe(
             flip,
             lift,
             trial.energy,
-            resting.energy,
+            rest_energy,
         )
         if lift > diameter and trial.stable and (best is None or trial.energy < best.energy):
             best = trial
     if best is None:
         return None, None, spent
-    gap = best.energy - resting.energy
-    tol = 1e-9 * max(abs(resting.energy), abs(best.energy), 1e-300)
-    return (best if gap < -tol else None), gap, spent
+    gap = best.energy - rest_energy
+    tol = 1e-9 * max(abs(rest_energy), abs(best.energy), 1e-300)
+    if gap >= -tol:
+        return None, gap, spent
+    if frictional:  # an equilibrium of the ramp's own (frictional) problem, lagged at itself
+        try:
+            held = solve_static(
+                model, supports, loads, initial=best.state, options=options, contact=settings
+            )
+        except (ConvergenceError, InfeasibleContactError) as err:
+            spent += int(getattr(getattr(err, "result", None), "iterations", 0))
+            phase_log.debug("lift probe: the lifted state did not settle with friction")
+            return None, gap, spent
+        spent += held.iterations
+        if not (held.stable and _rise(floor, lattice, held.positions) > diameter):
+            return None, gap, spent
+        best = held
+    return best, gap, spent
+
+
+def _settle_weightless(
+    model: Model, supports: Supports, start: State, options: NewtonOptions, contact: Contact
+) -> tuple[StaticResult | None, int]:
+    """The weightless equilibrium reached from ``start`` (None where none was reached) and the
+    Newton iterations spent: a solve that runs out of iterations is continued from its last
+    iterate, up to :data:`SEARCH_SOLVES` solves."""
+    spent = 0
+    for _ in range(SEARCH_SOLVES):
+        try:
+            free = solve_static(
+                model, supports, Loads(), initial=start, options=options, contact=contact
+            )
+        except (ConvergenceError, InfeasibleContactError) as err:
+            result = getattr(err, "result", None)
+            spent += int(getattr(result, "iterations", 0))
+            last = getattr(err, "state", None)
+            if getattr(result, "status", None) is not Status.MAX_ITERATIONS or last is None:
+                phase_log.debug("lift probe: the weightless lattice did not settle (%d its)", spent)
+                return None, spent
+            phase_log.debug("lift probe: the weightless search continues (%d its)", spent)
+            start = last
+            continue
+        return free, spent + free.iterations
+    phase_log.debug("lift probe: the weightless lattice did not settle (%d its)", spent)
+    return None, spent
+
+
+def _potential_energy(
+    model: Model, supports: Supports, loads: Loads, contact: Contact, state: State
+) -> float:
+    """Total potential energy of ``state`` (N mm): elastic, minus the work of the loads, plus
+    the contact barrier of ``contact`` (a frictionless copy of the ramp's: no lagged friction).
+    The barrier stiffness follows from the model and loads alone, so it is the ramp's."""
+    obj = RodObjective(model, state, supports, loads, contact)
+    return float(obj.evaluate(obj.vector(), False, 0)[0])
 
 
 def _refine_lift_off(
