@@ -9,6 +9,8 @@
                               counted, converged, discretisation_error, resolution, note, unit,
                               figure (:mod:`rotomorph.simulate.validation`)
     prediction_table.md       the README's prediction table (one line per measured quantity)
+    published_fig4_sweep.json the authors' own Fig. 4 simulation rebuilt: its stretch sweep
+                              (:mod:`rotomorph.simulate.report_published`)
     calibration.json          the joint calibrations (both modulus-ratio branches, the choice and
                               why, priors) and the out-of-sample score
     figures/*.png
@@ -23,8 +25,9 @@ the two end in different stable states (a multistable lattice), the one lower in
 is counted (:mod:`rotomorph.lattice.paths`) and the row's note says so.
 
 Sections: Janus curvature vs speed (Fig. 2D), L/L0 vs ω* (Fig. 2F/G), sinusoidal filaments
-(Fig. 3C/D), lattice areas (Fig. 3G), dome and saddle lattices (Fig. 4). A lattice part that
-fails becomes rows with ``predicted = null`` and the reason in ``note``.
+(Fig. 3C/D), lattice areas (Fig. 3G), dome and saddle lattices (Fig. 4), and the authors' own
+simulation of Fig. 4 rebuilt (no rows: it compares two simulations, not a measurement). A
+lattice part that fails becomes rows with ``predicted = null`` and the reason in ``note``.
 """
 
 from __future__ import annotations
@@ -778,6 +781,7 @@ def _markdown(
     summary: dict[str, Any],
     timings: dict,
     quick: bool,
+    extra: list[str] | None = None,
 ) -> str:
     full = val.calibrations["all"]
     fit = full.chosen
@@ -879,6 +883,7 @@ def _markdown(
                     name = f"lattice_{pattern}_views{suffix}.png"
                     if name in names:
                         lines += [f"![{pattern}{suffix}](figures/{name})", ""]
+    lines += extra or []
     if summary["misses_beyond_2"]:
         lines += ["## Misses beyond 2 combined spreads", ""]
         lines += [f"- {m}" for m in summary["misses_beyond_2"]] + [""]
@@ -892,6 +897,25 @@ def _markdown(
         "",
     ]
     return "\n".join(lines)
+
+
+def _published(out: Path, figs: Path, quick: bool) -> tuple[list[str], list[Path]]:
+    """The section on the authors' own Fig. 4 simulation (Markdown lines, figures); a failed
+    sweep becomes a section that says why."""
+    from rotomorph.simulate.report_published import published_section
+
+    try:
+        section = published_section(out, figs, quick=quick)
+    except RotomorphError as err:
+        logger.warning("authors' Fig. 4 simulation: %s", err)
+        why = " ".join(str(err).split())[:300]
+        return [
+            "## The authors' own simulation of Fig. 4 (disMech), rebuilt",
+            "",
+            f"**Not computed**: the sweep failed ({why}).",
+            "",
+        ], []
+    return section.lines, section.figures
 
 
 #: Markers around the generated prediction table in README.md.
@@ -971,7 +995,7 @@ def paper_report(
     figs = out / "figures"
     figs.mkdir(parents=True, exist_ok=True)
     lattice_steps = 3 if quick else LATTICE_STEPS
-    total = 4 + 4
+    total = 4 + 5
 
     def tick() -> None:
         if progress is not None:
@@ -1001,6 +1025,11 @@ def paper_report(
         timings[name] = time.perf_counter() - t
         if name != "lattices (Fig. 3G, 4)":
             tick()
+    t = time.perf_counter()
+    published = _published(out, figs, quick)
+    figures += published[1]
+    timings["authors' Fig. 4 simulation rebuilt (two stretch sweeps)"] = time.perf_counter() - t
+    tick()
     rows = _ordered(val, [r for r in rows if r["quantity"].startswith("lattice")])
     summary = summarise(rows)
     wall = time.perf_counter() - t0
@@ -1012,7 +1041,9 @@ def paper_report(
         "calibrations": {k: c.record() for k, c in val.calibrations.items()},
     }
     atomic_write_text(out / "calibration.json", json.dumps(record, indent=1))
-    atomic_write_text(out / "report.md", _markdown(rows, figures, val, summary, timings, quick))
+    atomic_write_text(
+        out / "report.md", _markdown(rows, figures, val, summary, timings, quick, published[0])
+    )
     atomic_write_text(out / "prediction_table.md", prediction_table(rows, summary) + "\n")
     if summary["not_converged"] and not allow_unconverged:
         raise ConvergenceError(
