@@ -126,7 +126,14 @@ def authors_free_saddle():
     return solve_static(model, initial=perturbed_state(lm.model, bump), options=RAMP_OPTIONS)
 
 
-@pytest.mark.parametrize("friction", [0.0, FRICTION], ids=["frictionless", "friction 0.4"])
+@pytest.mark.parametrize(
+    "friction",
+    [
+        pytest.param(0.0, id="frictionless"),
+        # a frictional Newton iteration costs ~15 x a frictionless one (docs/published-simulation)
+        pytest.param(FRICTION, id="friction 0.4", marks=pytest.mark.slow),
+    ],
+)
 def test_the_authors_saddle_leaves_the_floor_where_it_is_lower(friction, authors_free_saddle):
     """The authors' saddle set-up (their lattice, edge lists, stretch -0.17, E = 2e11 Pa, their
     floor friction 0.4) under a negligible weight: the flat state on the floor is a strict
