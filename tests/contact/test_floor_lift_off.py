@@ -13,6 +13,7 @@ import pytest
 from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.errors import InvalidParameterError
+from rotomorph.lattice.actuation import CurvatureScaling
 from rotomorph.lattice.heating import (
     RAMP_OPTIONS,
     heat_lattice,
@@ -197,3 +198,28 @@ def test_lift_off_and_weightless_buckling_are_bisected_and_ordered(dome, ramps):
     assert b_hi <= lo
     with pytest.raises(InvalidParameterError, match="lift_off_tolerance"):
         heat_lattice(dome, actuation=ACT, steps=1, lift_off_tolerance=0.0)
+
+
+def test_the_probe_compares_potential_energies_the_solver_reports():
+    """The potential energy the probe evaluates for a resting state with friction is the one
+    the solver reports for the same state without friction (same barrier stiffness), and with
+    friction the solver's total exceeds it by the lagged friction term (>= 0)."""
+    from dataclasses import replace
+
+    from rotomorph.lattice.heating import _potential_energy, contact_settings
+    from rotomorph.solve.loads import Loads, Supports
+
+    lat = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="dome")
+    lm = lattice_model(lat, stiffness="paper")
+    model = CurvatureScaling("swapped").natural(lm, 0.3)
+    start = perturbed_state(lm.model, symmetry_breaking(lat, 1e-3 * lat.spacing, 0))
+    rough = contact_settings(lat, start.positions, False, True, 0.3)
+    slick = replace(rough, friction=0.0)
+    loads = Loads(gravity=lattice_gravity(lat))
+    res = solve_static(model, Supports(), loads, initial=start, contact=slick)
+    assert _potential_energy(model, Supports(), loads, slick, res.state) == pytest.approx(
+        res.energy, rel=1e-12
+    )
+    held = solve_static(model, Supports(), loads, initial=start, contact=rough)
+    potential = _potential_energy(model, Supports(), loads, slick, held.state)
+    assert held.energy >= potential - 1e-12 * abs(potential)
