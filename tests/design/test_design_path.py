@@ -5,7 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rotomorph.design.path import Arc, Line, Path, Polyline, Sinusoid, chain_segments
+from rotomorph.design.path import (
+    Arc,
+    Line,
+    Path,
+    Polyline,
+    Sinusoid,
+    chain_segments,
+    tangent_headings,
+)
 from rotomorph.errors import InvalidDesignError
 
 
@@ -107,3 +115,46 @@ def test_a_polyline_design_is_resolved_at_its_spacing():
     given = {**fil, "segments": [{**fil["segments"][0], "resample": False}]}
     with pytest.raises(InvalidDesignError, match="vertices"):
         parse_design({"schema_version": 1, "filaments": [given]})
+
+
+def test_tangent_headings_are_exact_at_the_ends_of_arcs():
+    # a chord's heading lags an arc's tangent by half the chord's turning angle (the mean of
+    # two edges at a join by a quarter): the tangent there is the arc's own
+    segs = [Line(20.0), Arc(60.0, np.pi / 3), Arc(30.0, -np.radians(40.0)), Line(10.0)]
+    pts, owner = chain_segments(segs, start=(20.0, 20.0, 0.0), spacing=1.0)
+    psi = tangent_headings(segs, pts, owner)
+    joins = np.flatnonzero(np.diff(owner)) + 1
+    want = [0.0, np.pi / 3, np.pi / 3 - np.radians(40.0)]
+    np.testing.assert_allclose(psi[joins], want, atol=1e-15)
+    np.testing.assert_allclose(psi[[0, -1]], [0.0, np.pi / 3 - np.radians(40.0)], atol=1e-15)
+    # elsewhere the polygon's vertex heading: the mean of its edges (exact inside an arc)
+    polygon = Path(pts).heading
+    mean = np.concatenate([[polygon[0]], 0.5 * (polygon[1:] + polygon[:-1]), [polygon[-1]]])
+    inner = np.setdiff1d(np.arange(len(pts)), [0, len(pts) - 1, *joins])
+    np.testing.assert_array_equal(psi[inner], mean[inner])
+    turn = np.pi / 3 / np.count_nonzero(owner[:-1] == 1)  # one chord's turn on the 60 mm arc
+    np.testing.assert_allclose(psi[joins[0]] - mean[joins[0]], -turn / 4, rtol=1e-9)
+    # ending on an arc (and starting on one, heading 90 deg): half a chord's turn
+    segs = [Arc(60.0, np.radians(50.0))]
+    pts, owner = chain_segments(segs, heading=np.pi / 2, spacing=1.0)
+    psi = tangent_headings(segs, pts, owner, heading=np.pi / 2)
+    np.testing.assert_allclose(psi[[0, -1]], np.pi / 2 + np.radians([0.0, 50.0]))
+    turn = np.radians(50.0) / (len(pts) - 1)
+    np.testing.assert_allclose(psi[-1] - Path(pts).heading[-1], turn / 2, rtol=1e-9)
+    assert np.degrees(turn / 2) > 0.45  # the 0.48 deg a 1 mm chord lags on 60 mm
+
+
+def test_tangent_headings_keep_corners_and_paths_without_arcs():
+    # a sinusoid meets the arc at an angle (its end tangent swings off the axis): a corner
+    segs = [Sinusoid(1.0, 5.0, 1.0), Arc(20.0, 1.0)]
+    pts, owner = chain_segments(segs, spacing=0.5)
+    psi = tangent_headings(segs, pts, owner)
+    polygon = Path(pts).heading
+    join = int(np.flatnonzero(np.diff(owner))[0]) + 1
+    assert psi[join] == pytest.approx(0.5 * (polygon[join - 1] + polygon[join]))
+    assert psi[-1] == pytest.approx(1.0)  # still the arc's tangent at the path end
+    segs = [Line(3.0), Sinusoid(1.0, 5.0, 2.0)]
+    pts, owner = chain_segments(segs, spacing=0.3)
+    polygon = Path(pts).heading
+    mean = np.concatenate([[polygon[0]], 0.5 * (polygon[1:] + polygon[:-1]), [polygon[-1]]])
+    np.testing.assert_array_equal(tangent_headings(segs, pts, owner), mean)

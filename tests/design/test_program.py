@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rotomorph.design.path import Arc, Path, Sinusoid
+from rotomorph.design.path import Arc, Line, Path, Sinusoid, chain_segments, tangent_headings
 from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidDesignError
 
@@ -130,3 +130,29 @@ def test_flip_length_limits_the_rotation_rate():
     np.testing.assert_allclose(smooth.nozzle_angle[far], step.nozzle_angle[far], atol=1e-9)
     with pytest.raises(InvalidDesignError, match="flip_length"):
         PrintProgram.sinusoid_with_active_side(path, 3.0, flip_length=-1.0)
+
+
+def test_a_nozzle_tracking_an_arc_keeps_its_interface_angle_to_the_arcs_end():
+    segs = [Line(10.0), Arc(60.0, -np.pi / 4)]
+    pts, owner = chain_segments(segs, start=(10.0, 10.0, 0.0), spacing=1.0)
+    psi = tangent_headings(segs, pts, owner)
+    prog = PrintProgram.from_interface_angle(pts, 3.0, 0.5, tangent_heading=psi)
+    assert prog.has_tangents
+    np.testing.assert_array_equal(prog.vertex_heading, psi)
+    np.testing.assert_allclose(prog.nozzle_angle[[-1, 10]], psi[[-1, 10]] - 0.5)
+    np.testing.assert_allclose(prog.interface_angle, 0.5, atol=1e-12)  # every edge, the last too
+    assert np.all(prog.director_rotation == 0.0)  # tracks the tangent: winds no helix
+    # the vertex normals: α from d1 = +z toward d2 = t x d1 about the curve's tangent t
+    t = np.column_stack([np.cos(psi), np.sin(psi), np.zeros_like(psi)])
+    want = np.cos(0.5) * np.array([0.0, 0.0, 1.0]) + np.sin(0.5) * np.cross(t, [0.0, 0.0, 1.0])
+    np.testing.assert_allclose(prog.vertex_interface_normals, want, atol=1e-12)
+    # without the tangents the polygon's heading: the last chord lags the arc by half its turn
+    plain = PrintProgram.from_interface_angle(pts, 3.0, 0.5)
+    assert not plain.has_tangents
+    half = 0.5 * np.pi / 4 / np.count_nonzero(owner[:-1] == 1)
+    assert plain.nozzle_angle[-1] - prog.nozzle_angle[-1] == pytest.approx(half)
+    assert plain.interface_angle[-1] - 0.5 == pytest.approx(-half / 2)
+    with pytest.raises(InvalidDesignError, match="tangent_heading"):
+        PrintProgram(pts, 3.0, 0.0, tangent_heading=psi[:-1])
+    with pytest.raises(InvalidDesignError, match="tangent_heading"):
+        PrintProgram.from_interface_angle(pts, 3.0, 0.5, tangent_heading=psi[1:])

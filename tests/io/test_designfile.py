@@ -340,3 +340,32 @@ def test_bad_lattice_edge_speeds_are_one_line_errors(speeds, match):
     with pytest.raises(InvalidDesignError, match=match) as err:
         parse_design(data)
     assert "\n" not in str(err.value)
+
+
+def test_a_filament_with_arcs_tracks_their_tangent_and_others_are_unchanged():
+    from rotomorph.design.program import PrintProgram
+
+    # no example has an arc: their programs are the polygon's, as before
+    for path in EXAMPLES:
+        assert not any(p.has_tangents for p in load_design(path).to_programs())
+    d = parse_design(
+        {
+            "schema_version": 1,
+            "filaments": [
+                {
+                    "interface_angle_deg": 20.0,
+                    "spacing": 1.0,
+                    "segments": [
+                        {"kind": "line", "length": 5.0},
+                        {"kind": "arc", "radius": 60.0, "angle_deg": 30.0},
+                    ],
+                }
+            ],
+        }
+    )
+    prog = d.to_programs()[0]
+    assert prog.has_tangents
+    assert prog.nozzle_angle[-1] == pytest.approx(np.radians(30.0 - 20.0))  # the arc's end
+    polygon = PrintProgram.from_interface_angle(prog.points, 3.0, np.radians(20.0))
+    np.testing.assert_allclose(prog.nozzle_angle[1:-1][:4], polygon.nozzle_angle[1:-1][:4])
+    assert abs(polygon.nozzle_angle[-1] - prog.nozzle_angle[-1]) > np.radians(0.4)

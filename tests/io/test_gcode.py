@@ -172,6 +172,26 @@ def test_serpentine_reverses_the_same_physical_filament():
     )
 
 
+def test_serpentine_mirrors_a_program_about_its_curves_tangent():
+    from rotomorph.design.path import Arc, Line, chain_segments, tangent_headings
+
+    segs = [Line(5.0), Arc(20.0, 1.0), Line(5.0)]
+    pts, owner = chain_segments(segs, start=(10.0, 10.0, 0.0), spacing=1.0)
+    psi = tangent_headings(segs, pts, owner)
+    prog = PrintProgram.from_interface_angle(pts, 3.0, 0.5, tangent_heading=psi)
+    rev = reversed_program(prog)
+    np.testing.assert_allclose(rev.tangent_heading, (psi + np.pi)[::-1])
+    # printed backward: the interface angle mirrors (alpha' = -alpha) about the same tangent,
+    # at the arc's ends too, and the active half keeps its lab direction at every vertex
+    np.testing.assert_allclose(rev.nozzle_angle, rev.tangent_heading + 0.5, atol=1e-12)
+    np.testing.assert_allclose(
+        rev.vertex_interface_normals[::-1], prog.vertex_interface_normals, atol=1e-12
+    )
+    twice = reversed_program(rev)  # the same program, up to whole turns
+    np.testing.assert_allclose(twice.nozzle_angle, prog.nozzle_angle + 2 * np.pi, atol=1e-12)
+    np.testing.assert_allclose(twice.tangent_heading, psi + 2 * np.pi, atol=1e-12)
+
+
 finite = st.floats(-50, 50, allow_nan=False)
 
 

@@ -4,10 +4,12 @@
 program as the controller does and prints the canonical machine calls (``STRAIGHT_FEED(x, y, z,
 a, b, c)``, ``SET_FEED_RATE``, ``DWELL``, ``SET_AUX_OUTPUT_BIT``, …, 4 decimals). It runs here
 with the INI that ``rotomorph gcode --machine-config`` generates for ``examples/machines/
-linuxcnc.toml`` (non-wrapped C axis, abort handler). For every example design and a 6 × 6 dome
-lattice it must report 0 errors and 0 warnings, and its canonical output must match the design:
-positions ≤ 1e-4 mm, the cumulative rotary ≤ 1e-3°, ω = dα/ds · v per move to 2e-3 relative (the
-interpreter's 4 printed decimals), feeds, set-points, valves balanced and off at the end, dwells.
+linuxcnc.toml`` (non-wrapped C axis, abort handler). For every example design, a 6 × 6 dome
+lattice and a design of arcs it must report 0 errors and 0 warnings, and its canonical output
+must match the design: positions ≤ 1e-4 mm, the cumulative rotary ≤ 1e-3°, ω = dα/ds · v per
+move to 2e-3 relative (the interpreter's 4 printed decimals), feeds, set-points, valves balanced
+and off at the end, dwells; on the arcs, where the nozzle tracks the path, C is the arcs'
+tangent minus the interface angle at every vertex, their ends included (≤ 1e-3°).
 Then the same programs, aborted at several points and followed by the generated abort handler,
 leave every channel off. What rs274 does not check: acceleration, blending and the real-time
 motion (it plans nothing), and it accepts axis words outside the INI's COORDINATES.
@@ -15,48 +17,23 @@ motion (it plans nothing), and it accepts axis words outside the INI's COORDINAT
 
 from __future__ import annotations
 
-import functools
 import re
 import subprocess
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _gcode_cases import NAMES, ROOT, tangent_errors, written
 
-from rotomorph.io.designfile import load_design
-from rotomorph.io.gcode import gcode_text, plan_programs
 from rotomorph.io.machine import load_machine_profile
 from rotomorph.io.machine_config import ABORT_SUBROUTINE, controller_files
 
 pytestmark = pytest.mark.referee
 
-ROOT = Path(__file__).parents[2] / "examples"
 PROFILE = ROOT / "machines" / "linuxcnc.toml"
-DESIGNS = sorted((ROOT / "designs").glob("*.toml"))
 INSTALL = "apt-get install linuxcnc-uspace"
 _CALL = re.compile(r"^\s*\d+ N\.\.\.\.\. (\w+)\((.*)\)\s*$")
-
-
-def _cases() -> dict[str, tuple[list, list]]:
-    """name → (programs, process) for every example design plus the 6 x 6 dome lattice."""
-    out = {}
-    for path in DESIGNS:
-        d = load_design(path)
-        out[path.stem] = (d.to_programs(), d.gcode_options()["process"])
-    d = load_design(ROOT / "designs" / "lattice_dome.toml")
-    six = d.model_copy(update={"lattice": d.lattice.model_copy(update={"n": 6})})
-    out["lattice_dome_6x6"] = (six.to_programs(), six.gcode_options()["process"])
-    return out
-
-
-@functools.cache
-def _written() -> dict[str, tuple[str, list, list]]:
-    m = load_machine_profile(PROFILE)
-    out = {}
-    for name, (progs, process) in _cases().items():
-        text = gcode_text(progs, m, process=process, layer_cure_s=20.0)
-        out[name] = (text, plan_programs(progs, m), process)
-    return out
 
 
 def _run(rs274: str, folder: Path, program: str, ini_files: dict[str, str]) -> list[tuple]:
@@ -101,10 +78,10 @@ def rs274(require_tool):
     return require_tool("rs274", INSTALL)
 
 
-@pytest.mark.parametrize("name", [*(p.stem for p in DESIGNS), "lattice_dome_6x6"])
+@pytest.mark.parametrize("name", [*NAMES, "arcs"])
 def test_rs274_runs_every_program_as_designed(rs274, tmp_path, name):
     m = load_machine_profile(PROFILE)
-    text, printed, process = _written()[name]
+    text, printed, process = written(name, PROFILE)
     calls = _run(rs274, tmp_path, text, controller_files(m, text))
     # walk the canonical calls: outputs, feeds and the feed moves with outputs on
     valve = {m.active_port: False, m.passive_port: False}
@@ -169,6 +146,13 @@ def test_rs274_runs_every_program_as_designed(rs274, tmp_path, name):
     for proc in process:
         for wanted in (proc.prime_dwell, proc.release_dwell):
             assert wanted == 0 or any(abs(d - wanted) < 1e-4 for d in dwells)
+    if name == "arcs":  # C as the interpreter reads it: the arcs' tangent − α, to their ends
+        read = [
+            SimpleNamespace(points=np.array(f["pts"]), nozzle_angle=np.radians(f["c"]))
+            for f in filaments
+        ]
+        off = tangent_errors(read)
+        assert len(off) == 3 and max(np.max(np.abs(o)) for o in off) <= 1e-3, off
 
 
 @pytest.mark.parametrize("name", ["composite_rotation", "lattice_dome_6x6"])
@@ -176,7 +160,7 @@ def test_an_aborted_program_leaves_every_channel_off(rs274, tmp_path, name):
     """The program cut at several points (mid-filament included), then the abort handler the
     generated INI names in ON_ABORT_COMMAND, run by rs274 with that INI."""
     m = load_machine_profile(PROFILE)
-    text = _written()[name][0]
+    text = written(name, PROFILE)[0]
     files = controller_files(m, text)
     ini = files["rotomorph.ini"]
     assert f"ON_ABORT_COMMAND = O <{ABORT_SUBROUTINE}> call" in ini

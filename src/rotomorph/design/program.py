@@ -121,6 +121,13 @@ class PrintProgram:
         field then takes them as steps at the edge midpoint, with no director helix wound
         by the flip itself (:attr:`director_rotation`). The G-code still turns the nozzle
         over that one edge.
+    tangent_heading
+        Heading ψ of the designed curve's tangent at each vertex ``(N,)`` (rad, unwrapped),
+        where it differs from the polygon's (:func:`~rotomorph.design.path.tangent_headings`:
+        at the ends of arcs); ``None`` (default): the polygon's vertex heading, the mean of
+        the two edges' (the edge's own at an end). The heading a nozzle that tracks the path
+        follows (:meth:`from_interface_angle`), the one a reversed print mirrors the nozzle
+        about, and the one :attr:`director_rotation` measures the nozzle's turn against.
 
     Raises
     ------
@@ -137,12 +144,14 @@ class PrintProgram:
     passive_material: str = "acrylate"
     layer: int = 0
     step_flips: bool = False
+    tangent_heading: FloatArray | None = None
 
     def __post_init__(self) -> None:
         pts = Path(self.points).points.copy()
         n = len(pts)
         arrays = {}
-        for name in ("speed", "nozzle_angle"):
+        names = ("speed", "nozzle_angle") + (("tangent_heading",) if self.has_tangents else ())
+        for name in names:
             raw = np.asarray(getattr(self, name), dtype=float)
             arr = np.array(np.broadcast_to(raw, (n,)) if raw.ndim == 0 else raw, dtype=float)
             if arr.shape != (n,):
@@ -184,6 +193,22 @@ class PrintProgram:
 
     # ----------------------------------------------------------------- derived
     @property
+    def has_tangents(self) -> bool:
+        """True when the program carries its curve's tangent headings (``tangent_heading``)."""
+        return self.tangent_heading is not None
+
+    @property
+    def vertex_heading(self) -> FloatArray:
+        """Heading ψ of the path's tangent at each vertex ``(N,)`` (rad, unwrapped).
+
+        ``tangent_heading`` if given, else the polygon's: the mean of the two edges' headings,
+        the edge's own at the ends.
+        """
+        if self.tangent_heading is not None:
+            return self.tangent_heading
+        return _vertex_heading(self.path)
+
+    @property
     def path(self) -> Path:
         """The print path."""
         return Path(self.points)
@@ -223,7 +248,7 @@ class PrintProgram:
         tracking one nothing, and straight ends keep their own rates. The nozzle angles (and
         the G-code) are not changed.
         """
-        psi = _vertex_heading(self.path)
+        psi = self.vertex_heading
         d_rel = np.diff(self.nozzle_angle - psi)
         # a nozzle that tracks the heading leaves round-off here, not a rotation (exact zeros
         # also let the section remember one print state for all of those vertices)
@@ -256,7 +281,8 @@ class PrintProgram:
         """Interface normals at the vertices ``(N, 3)`` (lab frame, unit).
 
         The vertex nozzle angle carried onto the vertex tangent (bisector of the two edges;
-        the edge's own at the ends), projected perpendicular to it. The natural field samples
+        the edge's own at the ends; turned in plane to ``tangent_heading`` where given),
+        projected perpendicular to it. The natural field samples
         the active side here (midpoint rule on each vertex's Voronoi cell): a flip between
         two vertices then acts as a step at the edge midpoint, the ideal sharp flip, whatever
         the vertex spacing (:func:`rotomorph.materials.natural.natural_field`).
@@ -265,6 +291,10 @@ class PrintProgram:
         te = e / np.linalg.norm(e, axis=1)[:, None]
         t = np.concatenate([te[:1], te[:-1] + te[1:], te[-1:]])
         t /= np.linalg.norm(t, axis=1)[:, None]
+        if self.tangent_heading is not None:  # the curve's tangent where the polygon's lags it
+            flat = np.hypot(t[:, 0], t[:, 1])
+            psi = self.tangent_heading
+            t = np.column_stack([flat * np.cos(psi), flat * np.sin(psi), t[:, 2]])
         n = _laid_down(t, self.nozzle_angle)
         n -= np.sum(n * t, axis=1)[:, None] * t
         return n / np.linalg.norm(n, axis=1)[:, None]
@@ -354,14 +384,22 @@ class PrintProgram:
 
         ``interface_angle`` is given per vertex (scalar, ``(N,)`` or a function of s in mm) and
         the nozzle follows :math:`\\alpha_n = \\psi_v - \\alpha` with :math:`\\psi_v` the vertex
-        heading (mean of the adjacent edges' headings). The per-edge :attr:`interface_angle` of
-        the result is then the edge mean of the vertex values up to O(h²) in curvature changes.
+        heading: ``tangent_heading`` if given in ``kwargs`` (the designed curve's tangent,
+        :func:`~rotomorph.design.path.tangent_headings`), else the mean of the adjacent edges'
+        headings. The per-edge :attr:`interface_angle` of the result is then the edge mean of
+        the vertex values up to O(h²) in curvature changes.
         """
         pts = _as_points(path)
         p = Path(pts)
         alpha = _per_vertex("interface_angle", interface_angle, p.arc_length)
         v = _per_vertex("speed", speed, p.arc_length)
-        return cls(pts, v, _vertex_heading(p) - alpha, **kwargs)  # type: ignore[arg-type]
+        given = kwargs.get("tangent_heading")
+        psi = _vertex_heading(p) if given is None else np.asarray(given, dtype=float)
+        if psi.shape != alpha.shape:
+            raise InvalidDesignError(
+                "tangent_heading", f"must have one value per vertex {alpha.shape}; got {psi.shape}"
+            )
+        return cls(pts, v, psi - alpha, **kwargs)  # type: ignore[arg-type]
 
     @classmethod
     def sinusoid_with_active_side(

@@ -74,6 +74,7 @@ from rotomorph.design.path import (
     Sinusoid,
     chain_segments,
     path_defect,
+    tangent_headings,
 )
 from rotomorph.design.program import PrintProgram, active_side_angle
 from rotomorph.errors import InvalidDesignError, MaterialError
@@ -418,11 +419,17 @@ class Filament(_Control, _Process):
 
         The nozzle angle integrates ω/v over each move (``rotation``, ``rotation_number``) or
         follows :math:`\\alpha_n = \\psi_v - \\alpha` (``interface_angle_deg``,
-        ``active_side``); a segment without a control uses the filament's, else ω = 0.
+        ``active_side``) with :math:`\\psi_v` the designed curve's tangent
+        (:func:`~rotomorph.design.path.tangent_headings`: exact at the ends of arcs, which a
+        program with arcs carries as ``tangent_heading``); a segment without a control uses
+        the filament's, else ω = 0.
         """
         pts, owner = self._points()
         path = Path(pts)
         speed = np.array([self.segments[o].speed or self.speed for o in owner])
+        geo = [_geometry(seg) for seg in self.segments]
+        # the tangent of the designed curve (exact at the ends of arcs, where a chord lags it)
+        psi_v = tangent_headings(geo, pts, owner, heading=math.radians(self.heading_deg))
         kw: dict[str, Any] = dict(
             radius=self.radius,
             active_fraction=self.active_fraction,
@@ -430,12 +437,12 @@ class Filament(_Control, _Process):
             passive_material=self.passive_material,
             layer=self.layer,
         )
+        if any(seg.kind == "arc" for seg in self.segments):
+            kw["tangent_heading"] = psi_v
         if self.active_side is not None:
             alpha = active_side_angle(path, self.active_side, self.flip_length)
             kw["step_flips"] = self.flip_length == 0  # ideal flips: steps in the natural field
             return PrintProgram.from_interface_angle(path, speed, alpha, **kw)
-        h = path.heading
-        psi_v = np.concatenate([[h[0]], 0.5 * (h[1:] + h[:-1]), [h[-1]]])
         s = path.arc_length
         angle = np.empty(len(s))
         for i in range(len(s)):

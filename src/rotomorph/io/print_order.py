@@ -1,8 +1,8 @@
 r"""Print order for a machine: serpentine lines and the profile's z offset.
 
 Reversing a filament prints the same filament backward. For a horizontal path with vertex
-heading :math:`\psi_v`, the interface normal toward the active half keeps its lab direction
-when the nozzle angle becomes
+heading :math:`\psi_v` (the program's ``vertex_heading``: its curve's tangent), the interface
+normal toward the active half keeps its lab direction when the nozzle angle becomes
 
 .. math:: \alpha_n' = 2\psi_v + \pi - \alpha_n
 
@@ -41,12 +41,16 @@ def reversed_program(program: PrintProgram) -> PrintProgram:
     """
     if not is_reversible(program):
         raise ValueError("only horizontal programs can be reversed")
-    heading = program.path.heading
-    psi_v = np.concatenate([[heading[0]], 0.5 * (heading[1:] + heading[:-1]), [heading[-1]]])
+    psi_v = program.vertex_heading  # the curve's tangent where the program carries it
     angle = 2 * psi_v + np.pi - program.nozzle_angle
     speed = np.concatenate([program.speed[:-1][::-1], [program.speed[0]]])
+    tangent = None if program.tangent_heading is None else (psi_v + np.pi)[::-1].copy()
     return dataclasses.replace(
-        program, points=program.points[::-1].copy(), speed=speed, nozzle_angle=angle[::-1].copy()
+        program,
+        points=program.points[::-1].copy(),
+        speed=speed,
+        nozzle_angle=angle[::-1].copy(),
+        tangent_heading=tangent,
     )
 
 
