@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib.util
 import json
 import logging
 import math
@@ -368,11 +369,31 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
     _print(f"wrote {out} ({machine.dialect}, {len(programs)} print program(s))")
     _gcode_extras(args, out, machine, options)
     if args.preview:
-        from rotomorph.plot.toolpath import save_toolpath_png
-
-        png = save_toolpath_png(plan_programs(programs, machine), out.with_suffix(".png"))
-        _print(f"wrote {png}")
+        _gcode_preview(out, plan_programs(programs, machine), design, machine)
     return EXIT_OK
+
+
+def _gcode_preview(out: Path, printed: Any, design: Any, machine: Any) -> None:
+    """``--preview``: FILE.png and the interactive FILE.preview.html (when plotly is there)."""
+    from rotomorph.plot.toolpath import save_toolpath_png
+
+    _print(f"wrote {save_toolpath_png(printed, out.with_suffix('.png'))}")
+    if importlib.util.find_spec("plotly") is None:  # an optional extra: the PNG stands alone
+        sys.stderr.write(
+            "rotomorph: note: no interactive preview (FILE.preview.html needs plotly: "
+            "pip install 'rotomorph[html]')\n"
+        )
+        return
+    from rotomorph.plot.toolpath_html import write_toolpath_html
+
+    page = write_toolpath_html(
+        printed,
+        out.with_suffix(".preview.html"),
+        names=design.program_names(),
+        title=f"{design.name or out.stem} on {machine.name}",
+        lift=machine.lift,
+    )
+    _print(f"wrote {page}")
 
 
 def _gcode_extras(args: argparse.Namespace, out: Path, machine: Any, options: Any) -> None:
@@ -565,7 +586,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--machine", metavar="PROFILE.toml", help="machine profile (see examples/machines)"
     )
     p.add_argument("--cure", type=float, default=0.0, metavar="S", help="UV dwell per layer (s)")
-    p.add_argument("--preview", action="store_true", help="also write FILE.png (toolpath)")
+    p.add_argument(
+        "--preview",
+        action="store_true",
+        help="also write FILE.png and FILE.preview.html (toolpath; the page needs plotly)",
+    )
     p.add_argument("--check", metavar="FILE", help="check an existing program instead")
     p.add_argument(
         "--machine-config",

@@ -369,3 +369,18 @@ def test_a_filament_with_arcs_tracks_their_tangent_and_others_are_unchanged():
     polygon = PrintProgram.from_interface_angle(prog.points, 3.0, np.radians(20.0))
     np.testing.assert_allclose(prog.nozzle_angle[1:-1][:4], polygon.nozzle_angle[1:-1][:4])
     assert abs(polygon.nozzle_angle[-1] - prog.nozzle_angle[-1]) > np.radians(0.4)
+
+
+def test_program_names_follow_the_programs():
+    d = load_design(Path(__file__).parents[2] / "examples" / "designs" / "lattice_dome.toml")
+    lattice = d.lattice
+    for name, prog in zip(d.program_names(), d.to_programs(), strict=True):
+        line, layer = name.split(", layer ")
+        axis, index = line.split("-line ")
+        along, across = (0, 1) if axis == "x" else (1, 0)
+        assert np.ptp(prog.points[:, along]) > 3 * np.ptp(prog.points[:, across])
+        offset = prog.points[0, across] - lattice.origin[across]
+        assert offset == pytest.approx(int(index) * lattice.spacing)
+        assert prog.layer == int(layer)
+    d = load_design(Path(__file__).parents[2] / "examples" / "designs" / "sinusoids.toml")
+    assert d.program_names() == [f.name for f in d.filaments]

@@ -1,4 +1,4 @@
-"""Toolpath preview PNG (rotomorph.plot.toolpath): written atomically and not blank."""
+"""Toolpath preview PNG (rotomorph.plot.toolpath): written atomically, not blank, legible."""
 
 from __future__ import annotations
 
@@ -21,6 +21,8 @@ def test_png_exists_and_is_not_blank(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["preview.png"]
     img = np.asarray(Image.open(out).convert("RGB"), dtype=float)
     assert img.shape[0] > 100 and img.std() > 5.0
+    # legible: a square part gets a 6 in panel at 150 dpi, about 900 px a side
+    assert img.shape[0] >= 900 and img.shape[1] >= 900
     # coloured pixels (the twilight map), not only black glyphs on white
     assert np.sum(np.ptp(img, axis=2) > 40) > 500
 

@@ -757,6 +757,19 @@ class Design(_Model):
             ]
         return sorted(progs, key=lambda p: p.layer)
 
+    def program_names(self) -> list[str]:
+        """A label per program of :meth:`to_programs`, in its order: each filament's name (or
+        ``filament i``), a lattice's ``x-line j`` / ``y-line i`` with the layer."""
+        named = [(f.layer, f.name or f"filament {i}") for i, f in enumerate(self.filaments)]
+        if self.lattice is not None:
+            n = self.lattice.n
+            lines = [f"x-line {j}" for j in range(n)] + [f"y-line {i}" for i in range(n)]
+            named += [
+                (k, f"{line}, layer {k}") for k in range(self.lattice.layers) for line in lines
+            ]
+        named.sort(key=lambda pair: pair[0])  # stable, as to_programs
+        return [name for _, name in named]
+
     def gcode_options(self) -> dict[str, Any]:
         """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (process, hash).
 
