@@ -10,7 +10,10 @@ interpreter of Marlin, RepRapFirmware or the Aerotech A3200 installs here).
 - Marlin, Klipper, RepRapFirmware: every command is one the firmware documents, and every axis
   word is one its ``G0``/``G1``/``G92`` accept (Klipper's ``G92``: X, Y, Z, E only — so no
   ``G92`` with a rotary word in a Klipper program);
-- pressure commands set explicit states: no Nordson toggle is ever written.
+- pressure commands set explicit states: no Nordson toggle is ever written;
+- on a design of arcs, in every dialect, C at every vertex where the nozzle tracks the path is
+  the arcs' tangent minus the interface angle, their ends included (the tangent from the arcs'
+  centres, computed in the test).
 """
 
 from __future__ import annotations
