@@ -190,3 +190,37 @@ def test_an_aborted_program_leaves_every_channel_off(rs274, tmp_path, name):
             assert before[-1].startswith("M64") and was_on
         assert valve == {m.active_port: False, m.passive_port: False}
         assert value == {m.active_port: 0.0, m.passive_port: 0.0}
+
+
+def test_every_ini_value_reads_back_as_written_by_linuxcncs_own_ini_reader(require_tool, tmp_path):
+    """LinuxCNC's INI reader (``inivar``, the same reader the controller uses) keeps an inline
+    comment as part of a value (``500  # note`` reads as that whole string), so every value
+    the generated INI holds must read back exactly as the bare value: numbers as numbers."""
+    inivar = require_tool("inivar", INSTALL)
+    m = load_machine_profile(PROFILE)
+    text, _, _ = written(NAMES[0], PROFILE)
+    ini = controller_files(m, text)["rotomorph.ini"]
+    (tmp_path / "rotomorph.ini").write_text(ini)
+    section, checked = "", 0
+    for line in ini.splitlines():
+        stripped = line.strip()
+        if not stripped or stripped[0] in "#;":
+            continue
+        if stripped.startswith("["):
+            section = stripped.strip("[]")
+            continue
+        key, value = (part.strip() for part in stripped.split("=", 1))
+        got = subprocess.run(
+            [inivar, "-var", key, "-sec", section, "-ini", "rotomorph.ini"],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        assert got.returncode == 0, (section, key, got.stderr)
+        assert got.stdout.strip() == value, (section, key, got.stdout)
+        assert "#" not in value and ";" not in value, (section, key, value)
+        if key.endswith(("LIMIT", "VELOCITY", "ACCELERATION")):
+            float(value)
+        checked += 1
+    assert checked >= 20

@@ -318,3 +318,16 @@ def test_design_file_process_per_filament(tmp_path):
     read = parse_gcode(out.read_text(), MachineProfile())
     assert [r.pressure for r in read] == [{"active": 12.0, "passive": 8.0}, {"active": 20.0}]
     assert [(r.prime_dwell, r.release_dwell) for r in read] == [(0.3, 0.0), (0.3, 0.2)]
+
+
+@pytest.mark.parametrize("cure", [-1.0, float("nan"), float("inf"), 1e9])
+def test_the_library_refuses_a_cure_dwell_outside_the_documented_range(cure):
+    """``write_gcode``/``gcode_text`` refuse what ``--cure`` refuses (a 31-year dwell), not
+    only the CLI: a script calling the library gets the same one-line error."""
+    from rotomorph.design.path import Line
+    from rotomorph.io.design_limits import MAX_LAYER_CURE_S
+
+    path = PrintPath.from_segments([Line(10.0)], spacing=0.5)
+    program = PrintProgram.from_rotation(path, speed=3.0, rotation=0.0)
+    with pytest.raises(InvalidParameterError, match=f"layer_cure_s.*{MAX_LAYER_CURE_S:g}"):
+        gcode_text([program], MachineProfile(), layer_cure_s=cure)

@@ -53,6 +53,7 @@ from rotomorph.design.program import PrintProgram
 from rotomorph.errors import InvalidParameterError, MachineLimitError, MaterialError
 from rotomorph.io import gcode_aerotech
 from rotomorph.io.atomic import atomic_write_text
+from rotomorph.io.design_limits import MAX_LAYER_CURE_S
 from rotomorph.io.machine import MachineProfile, check_line, fill_template
 from rotomorph.io.print_order import machine_order
 from rotomorph.materials.material import get_material, known_materials
@@ -589,8 +590,11 @@ def gcode_text(
     layers = [p.layer for p in programs]
     if any(b < a for a, b in itertools.pairwise(layers)):
         raise InvalidParameterError("programs", "must be ordered by layer (non-decreasing)")
-    if not (math.isfinite(layer_cure_s) and layer_cure_s >= 0):
-        raise InvalidParameterError("layer_cure_s", f"must be >= 0 s; got {layer_cure_s}")
+    if not (math.isfinite(layer_cure_s) and 0 <= layer_cure_s <= MAX_LAYER_CURE_S):
+        raise InvalidParameterError(
+            "layer_cure_s",
+            f"must be a UV dwell per layer in [0, {MAX_LAYER_CURE_S:g}] s; got {layer_cure_s}",
+        )
     if design_hash is not None and not re.fullmatch(r"[0-9a-f]{64}", design_hash):
         raise InvalidParameterError("design_hash", "must be a sha256 hex digest (64 characters)")
     check_materials(programs)

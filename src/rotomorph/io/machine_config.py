@@ -95,7 +95,9 @@ def _linuxcnc(m: MachineProfile, program: str) -> dict[str, str]:
             f"MIN_LIMIT = {a:g}",
             f"MAX_LIMIT = {b:g}",
             f"MAX_VELOCITY = {linear:g}",
-            "MAX_ACCELERATION = 500  # SET_ME: your axis",
+            "# SET_ME: the acceleration your axis can follow (LinuxCNC's INI reader keeps an",
+            "# inline comment as part of the value, so comments stand on their own lines)",
+            "MAX_ACCELERATION = 500",
         ]
     ini += [
         "",
@@ -106,7 +108,8 @@ def _linuxcnc(m: MachineProfile, program: str) -> dict[str, str]:
         f"MIN_LIMIT = {-span:g}",
         f"MAX_LIMIT = {span:g}",
         f"MAX_VELOCITY = {rotary:.6g}",
-        "MAX_ACCELERATION = 20000  # SET_ME: your rotary stage",
+        "# SET_ME: the acceleration your rotary stage can follow",
+        "MAX_ACCELERATION = 20000",
     ]
     abort = [
         f"o<{ABORT_SUBROUTINE}> sub",
