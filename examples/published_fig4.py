@@ -28,7 +28,7 @@ value; writes ``OUT/published_fig4_sweep.png`` (√|k1 k2| and sign against stre
 ``OUT/published_fig4_shapes.png`` (domes and saddles).
 
 Run: ``python examples/published_fig4.py -o published_out`` (the full sweep, about two
-minutes of CPU on the floor); ``--quick``: 11 values, |stretch| ≤ 0.25 by 0.05.
+minutes of CPU on the floor); ``--quick``: 11 values, stretch magnitude ≤ 0.25 by 0.05.
 """
 
 from __future__ import annotations

@@ -320,7 +320,7 @@ def published_sweep(
     Parameters
     ----------
     step, end
-        Stretch spacing and largest |stretch| (``end / step`` must be a whole number).
+        Stretch spacing and largest stretch magnitude (``end / step`` must be a whole number).
     floor
         Rest on a floor just below the print (the authors' floor); False: a free lattice.
     friction

@@ -8,7 +8,8 @@ limit of a negligible weight), and writes:
 
 * ``figures/published_fig4_sweep.png``: √|k1 k2| against stretch, coloured by the Gaussian
   sign, and the rise off the floor;
-* ``figures/published_fig4_shapes.png``: the dome and the saddle at |stretch| = 0.3 and 0.75;
+* ``figures/published_fig4_shapes.png``: the dome and the saddle at stretch
+  magnitudes 0.3 and 0.75;
 * ``published_fig4_sweep.json``: one record per stretch value of both sweeps;
 * Markdown: what was rebuilt, where the two set-ups differ, the onsets, the logged run's
   stretch, and the cost of the whole sweep next to the authors' per-run time.
@@ -41,10 +42,10 @@ from rotomorph.simulate.cache import disk_cached
 
 __all__ = ["PublishedSection", "published_section", "records", "shapes_figure", "sweep_figure"]
 
-#: Stretch spacing and largest |stretch| of the report's sweeps (quick mode: a short smoke run
-#: of 11 values; coarser steps cost more, not less: each jump is a long Newton path).
+#: Stretch spacing and largest stretch magnitude of the report's sweeps (quick mode: a short
+#: smoke run of 11 values; coarser steps cost more, not less: each jump is a long Newton path).
 GRID = {False: (0.01, 0.75), True: (0.05, 0.25)}
-#: |stretch| at which the dome and saddle are drawn.
+#: Stretch magnitudes at which the dome and saddle are drawn.
 SHOWN = (0.3, 0.75)
 #: Above this fit residual (over the rise) the quadratic surface no longer describes the shape.
 POOR_FIT = 0.1
@@ -135,7 +136,7 @@ def sweep_figure(on_floor: PublishedSweep, weightless: PublishedSweep | None = N
 
 
 def shapes_figure(sweep: PublishedSweep, shown: tuple[float, ...] = SHOWN) -> Any:
-    """The dome and the saddle at |stretch| in ``shown``: 3-D line views, coloured by height."""
+    """The dome and the saddle at the stretch magnitudes ``shown``: 3-D views coloured by height."""
     from matplotlib.colors import Normalize
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
