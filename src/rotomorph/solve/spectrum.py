@@ -2,28 +2,42 @@ r"""Is an equilibrium a minimum? Inertia and lowest eigenvalues of a Hessian on 
 
 An equilibrium ``x`` (zero gradient) of a smooth energy is a strict local minimum when the
 Hessian ``H`` is positive definite on every direction that changes the energy. Directions that
-never change it (rigid motions of an unsupported body) are removed first: their span ``R`` is
-supplied by the objective, and only the part of it that ``H`` annihilates numerically (Rayleigh
-quotient below a tolerance) is removed, so a floor or a support that stiffens a rigid motion keeps
-it in the test.
+never change it (rigid motions of an unsupported body) are removed first. Their candidate span
+``R`` is supplied by the objective; a candidate is removed only where it is null *relative to
+the rest of the spectrum*. In the eigenbasis of the span's own curvature, direction ``b_j`` has
+the Rayleigh quotient ``mu_j`` and couples to the ``M``-orthogonal complement with a strength
+``rho_j = |M^{-1/2}(H b_j - mu_j M b_j)|``; with ``lambda_1`` the lowest eigenvalue of the
+complement, ``b_j`` can move the lowest eigenvalue of the whole by about
+``|mu_j| + rho_j^2 / lambda_1``, and it is removed when that is at most ``NULL_TOL`` (1e-3) of
+``lambda_1``. A rigid motion is an exact symmetry only when nothing acts on it: at an
+equilibrium ``mu_j`` of a rigid rotation is the dead loads' second variation along it
+(``-sum_i f_i . (w x (w x r_i))``: negative for a free rod under self-equilibrated
+compression, which a half turn relieves) and ``rho_j`` follows from ``H (w x r) = w x f``. Such a
+direction stays in the test and makes the point unstable; a floor or a tension that stiffens a
+rigid motion keeps it in the test with a positive curvature. The reference is the spectrum's own
+scale, not the largest diagonal ratio (on a 5 x 5 lattice seven orders of magnitude above
+``lambda_1``), so a band of that ratio can no longer hide a rigid rotation that lowers the energy.
 
 Two certificates, cheapest first:
 
-1. **Cholesky** (when no eigenvalues are asked for): the Hessian with the rigid directions
-   removed (by eliminating ``k`` DOFs on which the rigid modes are independent, a complement of
-   their span; with ``H R = 0`` this leaves the inertia unchanged) is factored *unshifted*.
-   Success proves positive definiteness.
+1. **Cholesky** (when no eigenvalues are asked for): ``H - s M`` with every candidate direction
+   removed (by eliminating ``k`` DOFs on which they are independent, a complement of their span)
+   is factored, with the shift ``s`` just large enough that success proves ``lambda_1 >= s``
+   for the smallest ``lambda_1`` at which every candidate is null (``_Rigid.shift``; ``s = 0``
+   without candidates, and a few times the round-off of the rigid curvatures otherwise).
+   Success proves positive definiteness with every candidate removed.
 2. **Eigenvalues** (when asked for, or when the factorization fails): the lowest eigenvalues
    of the pencil ``H v = lambda M v`` restricted to the ``M``-orthogonal complement of the
-   rigid span (``M`` the solver's diagonal metric: Voronoi length per position DOF, ``l^3`` per
-   twist angle, so ``lambda`` has units of N/mm²). Small problems use a dense symmetric
+   candidate span (``M`` the solver's diagonal metric: Voronoi length per position DOF, ``l^3``
+   per twist angle, so ``lambda`` has units of N/mm²); when a candidate is not null, again on
+   the complement of the null ones only. Small problems use a dense symmetric
    eigensolver; large ones shift-invert Lanczos (:mod:`rotomorph.solve.lanczos`, stopping as
    soon as the wanted Ritz values converge; ARPACK's implicitly restarted Lanczos, SciPy
    ``eigsh``, if they have not within its basis) with the shift below the lowest eigenvalue,
    found by trial factorizations (Ericsson & Ruhe, *Math. Comp.* 35, 1980; a trial that a
-   rigid direction's negative Rayleigh quotient already rules out is skipped), and the rigid
-   span projected out of every solve. An unstable point's eigenpairs come from ARPACK in every
-   case: the solver leaves the saddle along its mode.
+   kept rigid direction's negative Rayleigh quotient already rules out is skipped), and the
+   removed span projected out of every solve. An unstable point's eigenpairs come from ARPACK
+   in every case: the solver leaves the saddle along its mode.
 
 ``stable`` is True when the Cholesky certificate succeeds or the lowest eigenvalue is above
 ``-tol * scale`` (``scale`` the largest diagonal ratio ``H_ii / M_ii``): an eigenvalue within
@@ -41,7 +55,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from rotomorph._typing import FloatArray, IntArray
+from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.solve.lanczos import shift_invert_lanczos
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix, factorize, matvec
 
@@ -49,6 +63,9 @@ __all__ = ["DENSE_LIMIT", "Spectrum", "analyse_hessian", "to_csc"]
 
 #: Problem size (free DOFs less rigid modes) up to which the dense eigensolver is used.
 DENSE_LIMIT = 240
+#: A candidate rigid direction is removed when its curvature and coupling can move the lowest
+#: eigenvalue of the rest by at most this fraction of it (:meth:`_Rigid.null`)
+NULL_TOL = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,26 +138,82 @@ def _dense(H: Any) -> FloatArray:
     return np.array(H, dtype=float)
 
 
-def _rigid_null_space(
-    H: Any, M: FloatArray, rigid: FloatArray, tol: float
-) -> tuple[FloatArray, float]:
-    """``M``-orthonormal basis of the combinations of ``rigid`` that ``H`` annihilates, and the
-    lowest Rayleigh quotient ``v^T H v / v^T M v`` over the span of ``rigid`` (an upper bound
-    of the lowest eigenvalue of the pencil; ``inf`` without rigid directions)."""
+@dataclass(frozen=True, eq=False)
+class _Rigid:
+    """The candidate rigid span in the eigenbasis of its own curvature.
+
+    ``basis`` (n, k): ``M``-orthonormal, diagonalising ``B^T H B``; ``curvature`` (k,): those
+    Rayleigh quotients ``mu_j = b_j^T H b_j`` (ascending, N/mm²); ``coupling`` (k,): how
+    strongly each direction couples to the rest, ``rho_j = |M^{-1/2} (H b_j - mu_j M b_j)|``
+    (the same units).
+    """
+
+    basis: FloatArray
+    curvature: FloatArray
+    coupling: FloatArray
+
+    @property
+    def count(self) -> int:
+        return int(self.basis.shape[1])
+
+    def shift(self, tol: float = NULL_TOL) -> float:
+        """Shift ``s`` of the Cholesky certificate (N/mm²): if ``H - s M`` factors with the
+        whole span eliminated, the lowest eigenvalue ``lambda_1`` of the complement is at least
+        ``s0`` (the smallest reference at which :meth:`null` removes every direction), so every
+        direction is null and the complement positive definite.
+
+        Proof: success means ``H - s M`` is positive definite on a subspace of codimension
+        ``k``, so the pencil's ``(k+1)``-th eigenvalue exceeds ``s`` (Courant–Fischer). In the
+        basis of the span and its ``M``-orthogonal complement ``H`` is the block diagonal of
+        ``diag(mu)`` and the complement's block plus a coupling of norm at most
+        ``|rho|_2``, which moves every eigenvalue by at most that much (Weyl): the block
+        diagonal's ``(k+1)``-th eigenvalue exceeds ``s - |rho|_2 = s0``, and since every
+        ``mu_j < s0`` the complement's lowest eigenvalue does.
+        """
+        mu, rho = np.abs(self.curvature), self.coupling
+        if not len(mu):
+            return 0.0
+        # |mu| + rho^2 / s0 <= tol s0 for every direction
+        s0 = float(np.max((mu + np.sqrt(mu**2 + 4.0 * tol * rho**2)) / (2.0 * tol)))
+        return s0 + float(np.linalg.norm(rho))
+
+    def null(self, reference: float, tol: float = NULL_TOL) -> BoolArray:
+        """Which directions are removed, given the lowest eigenvalue ``reference`` (> 0) of
+        the complement: those whose own curvature and coupling can move it by at most ``tol``
+        times itself, ``|mu_j| + rho_j^2 / reference <= tol * reference`` (a direction of
+        curvature ``mu`` coupled by ``rho`` to a complement whose lowest eigenvalue is
+        ``lambda`` turns the pair's lowest eigenvalue into ``mu - rho^2 / (lambda - mu)`` to
+        leading order)."""
+        mu, rho = np.abs(self.curvature), self.coupling
+        return np.asarray(mu + rho**2 / reference <= tol * reference)
+
+
+def _rigid_directions(
+    H: Any, M: FloatArray, rigid: FloatArray, action: FloatArray | None = None
+) -> _Rigid:
+    """:class:`_Rigid` of the candidate directions ``rigid`` (n, k); ``action`` (n, k): the
+    part of ``H`` times each candidate that the symmetry itself implies (see
+    :func:`analyse_hessian`), taken off before the curvatures and couplings are measured."""
+    n = len(M)
     if rigid.size == 0:
-        return np.zeros((len(M), 0)), np.inf
+        return _Rigid(np.zeros((n, 0)), np.zeros(0), np.zeros(0))
     # M-orthonormalise through the small Gram matrix (k <= 6 columns)
     G = np.einsum("ik,i,il->kl", rigid, M, rigid)
     w, V = np.linalg.eigh(G)
     ok = w > 1e-12 * max(float(w.max()), 1e-300)
-    basis = rigid @ (V[:, ok] / np.sqrt(w[ok]))
+    to_basis = V[:, ok] / np.sqrt(w[ok])
+    basis = rigid @ to_basis
     if basis.shape[1] == 0:
-        return basis, np.inf
+        return _Rigid(basis, np.zeros(0), np.zeros(0))
     cols = range(basis.shape[1])
     HB = np.column_stack([matvec(H, np.ascontiguousarray(basis[:, j])) for j in cols])
+    if action is not None:
+        HB = HB - action @ to_basis
     C = basis.T @ HB
     mu, W = np.linalg.eigh(0.5 * (C + C.T))
-    return basis @ W[:, np.abs(mu) <= tol], float(mu[0])
+    basis, HB = basis @ W, HB @ W
+    rest = (HB - (M[:, None] * basis) * mu) / np.sqrt(M)[:, None]
+    return _Rigid(basis, mu, np.linalg.norm(rest, axis=0))
 
 
 def _pivots(R: FloatArray) -> IntArray:
@@ -156,18 +229,20 @@ def _pivots(R: FloatArray) -> IntArray:
     return np.array(picks, dtype=np.int64)
 
 
-def _reduced_is_positive_definite(H: Any, R: FloatArray, scale: float) -> bool:
-    """Unshifted Cholesky of ``H`` with the rigid span removed.
+def _cholesky_verdict(H: Any, M: FloatArray, rigid: _Rigid, scale: float, tol: float) -> bool:
+    """Whether one Cholesky factorization proves the point stable with every candidate rigid
+    direction null (:meth:`_Rigid.shift`).
 
-    Without rigid modes it is ``H`` itself. With ``k`` of them, ``k`` DOFs on which they are
-    independent (a complement of their span) are eliminated by stiff springs of ``1e16`` times
-    the diagonal scale on those DOFs only: by the Schur complement the result is positive
-    definite exactly when ``H`` with those DOFs deleted is, up to ``1e-16`` of the scale, and
-    the solver's cached symbolic factorization is reused (a diagonal change keeps the pattern).
+    ``H - s M`` is factored with ``k`` DOFs on which the rigid directions are independent (a
+    complement of their span) eliminated by stiff springs of ``1e16`` times the diagonal scale
+    on those DOFs only: by the Schur complement the result is positive definite exactly when
+    ``H - s M`` with those DOFs deleted is, up to ``1e-16`` of the scale, and the solver's
+    cached symbolic factorization is reused (a diagonal change keeps the pattern). Without
+    rigid directions ``s = 0``: the unshifted factorization of ``H`` itself.
     """
-    shift = np.zeros(R.shape[0])
-    if R.shape[1]:
-        shift[_pivots(R)] = 1e16 * scale
+    shift = -rigid.shift(tol) * M
+    if rigid.count:
+        shift[_pivots(rigid.basis)] = 1e16 * scale
     return factorize(H, shift) is not None
 
 
@@ -179,7 +254,8 @@ def analyse_hessian(
     count: int = 3,
     modes: bool = False,
     tol: float = 1e-12,
-    null_tol: float = 1e-6,
+    null_tol: float = NULL_TOL,
+    rigid_action: FloatArray | None = None,
 ) -> Spectrum:
     """Stability verdict and lowest eigenvalues of ``H`` (see the module docstring).
 
@@ -199,43 +275,75 @@ def analyse_hessian(
     tol
         Eigenvalues above ``-tol * scale`` count as non-negative (neutral).
     null_tol
-        A rigid direction is removed when its Rayleigh quotient is within ``null_tol * scale``
-        of zero.
+        A rigid direction of curvature ``mu`` and coupling ``rho`` to the rest is removed when
+        ``|mu| + rho^2 / lambda_1 <= null_tol * lambda_1``, ``lambda_1`` the lowest eigenvalue
+        of the complement of the rigid span (in magnitude, at least ``tol * scale``).
+    rigid_action
+        ``(n, k)``: the part of ``H rigid`` that the symmetry itself implies at a point that is
+        not an equilibrium (for an energy invariant under a rotation ``w``, differentiating
+        the invariance gives ``H (w x r) = w x grad E`` on the positions; 0 for a
+        translation). Default 0: the point is an equilibrium, where the curvatures ``H``
+        shows along the candidates are the loads' exact action on them.
     """
     M = np.asarray(M, dtype=float)
     n = len(M)
     d = np.asarray(H.diagonal if isinstance(H, BandedMatrix) else H.diagonal(), dtype=float)
     scale = max(float(np.max(np.abs(d) / M)) if n else 1.0, 1e-300)
-    R, bound = _rigid_null_space(
-        H, M, np.zeros((n, 0)) if rigid is None else rigid, null_tol * scale
-    )
-    k = R.shape[1]
-    m = n - k
-    if m <= 0:
-        empty = np.zeros(0)
-        return Spectrum(True, empty, np.zeros((n, 0)) if modes else None, k, "cholesky", scale, 0)
+    rig = _rigid_directions(H, M, np.zeros((n, 0)) if rigid is None else rigid, rigid_action)
+    k = rig.count
     nfact = 0
-    if count <= 0:
+    if count <= 0 and n > k:
         nfact += 1
-        if _reduced_is_positive_definite(H, R, scale):
+        if _cholesky_verdict(H, M, rig, scale, null_tol):
             return Spectrum(True, np.zeros(0), None, k, "cholesky", scale, nfact)
-    want = min(max(int(count), 1), m)
-    vec: FloatArray | None
-    if m <= DENSE_LIMIT:
-        lam, vec = _dense_eigen(H, M, R, want)
-    else:
-        lam, vec, extra = _sparse_eigen(H, M, R, want, scale, modes, tol, bound)
+    # the shifted factorizations are of the whole H: the lowest rigid curvature bounds its
+    # lowest eigenvalue from above, and the shifts it rules out are skipped
+    bound = float(rig.curvature[0]) if k else np.inf
+    # 1. the complement of the whole candidate span: its lowest eigenvalue is the reference
+    #    of which candidates are null
+    lam, vec, extra = _eigen(H, M, rig.basis, count, scale, modes, tol, bound)
+    nfact += extra
+    reference = max(abs(float(lam[0])) if len(lam) else 0.0, tol * scale)
+    null = rig.null(reference, null_tol)
+    removed = int(np.count_nonzero(null))
+    if removed < k:
+        # 2. the candidates that are not null (a rigid rotation a dead load turns, a motion a
+        #    support holds) stay in the test
+        lam, vec, extra = _eigen(H, M, rig.basis[:, null], count, scale, modes, tol, bound)
         nfact += extra
-    stable = bool(lam[0] >= -tol * scale)
+    stable = bool(lam[0] >= -tol * scale) if len(lam) else True
     return Spectrum(
         stable=stable,
         eigenvalues=lam,
         modes=_normalise_signs(vec) if (vec is not None and (modes or not stable)) else None,
-        rigid=k,
+        rigid=removed,
         certificate="eigenvalues",
         scale=scale,
         factorizations=nfact,
     )
+
+
+def _eigen(
+    H: Any,
+    M: FloatArray,
+    R: FloatArray,
+    count: int,
+    scale: float,
+    vectors: bool,
+    tol: float,
+    bound: float,
+) -> tuple[FloatArray, FloatArray | None, int]:
+    """Lowest eigenpairs on the ``M``-orthogonal complement of ``R`` (``M``-orthonormal),
+    dense or sparse by size; none when the complement is empty. Returns them with the
+    factorizations spent."""
+    m = len(M) - R.shape[1]
+    if m <= 0:
+        return np.zeros(0), np.zeros((len(M), 0)), 0
+    want = min(max(int(count), 1), m)
+    if m <= DENSE_LIMIT:
+        lam, vec = _dense_eigen(H, M, R, want)
+        return lam, vec, 0
+    return _sparse_eigen(H, M, R, want, scale, vectors, tol, bound)
 
 
 def _normalise_signs(vec: FloatArray) -> FloatArray:

@@ -28,7 +28,7 @@ from rotomorph.solve.loads import Loads, Supports
 from rotomorph.solve.objective import RodObjective
 from rotomorph.solve.spectrum import analyse_hessian
 
-__all__ = ["Modes", "StabilityResult", "mode_fields", "stability"]
+__all__ = ["Modes", "StabilityResult", "mode_fields", "stability", "symmetry_action"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,6 +96,49 @@ def mode_fields(objective: RodObjective, vectors: FloatArray) -> Modes:
     return Modes(displacements=disp, twist=full[lay.theta].T.copy())
 
 
+def symmetry_action(objective: RodObjective, rigid: FloatArray, gradient: FloatArray) -> FloatArray:
+    """The part of ``H rigid`` that the rigid motions' symmetry implies at the base of
+    ``objective``, whether or not it is an equilibrium ``(n_free, k)``.
+
+    An energy invariant under the rotations of the body satisfies ``E(R x) = E(x)``;
+    differentiating ``grad E(R(t) x) = R(t) grad E(x)`` at ``t = 0`` gives
+    ``H (w x r) = w x grad E`` on the node positions (twist angles, scalars, are unchanged), and
+    ``H t = 0`` for a translation. At an equilibrium this vanishes; away from one (the lift
+    probe's weightless lattice, analysed in the pose it rests in on the floor) it is what makes
+    a straight rigid rotation look curved (``-grad E . (w x (w x r))``) although the energy is
+    the same along the rotation itself. Whatever ``H rigid`` has beyond it is what breaks the
+    symmetry: dead loads, moments, supports. Each candidate's rotation ``w`` is recovered from
+    its node displacements (least squares over ``u_i = t + w x (x_i - c)``).
+    """
+    lay = objective.model.layout
+    k = rigid.shape[1]
+    free = objective.free
+    if k == 0:
+        return np.zeros((len(free), 0))
+    full = np.zeros((lay.count, k))
+    full[free] = rigid
+    dofs = lay.pos[:, None] + np.arange(3)
+    disp = full[dofs]  # (N, 3, k)
+    x = objective.base.positions
+    r = x - x.mean(axis=0)
+    n = len(x)
+    A = np.zeros((n, 3, 6))
+    A[:, :, :3] = np.eye(3)
+    # w x r = -[r]x w
+    A[:, 0, 4], A[:, 0, 5] = r[:, 2], -r[:, 1]
+    A[:, 1, 3], A[:, 1, 5] = -r[:, 2], r[:, 0]
+    A[:, 2, 3], A[:, 2, 4] = r[:, 1], -r[:, 0]
+    coef = np.linalg.lstsq(A.reshape(3 * n, 6), disp.reshape(3 * n, k), rcond=None)[0]
+    omega = coef[3:].T  # (k, 3)
+    g = np.zeros(lay.count)
+    g[free] = gradient
+    gpos = g[dofs]  # (N, 3)
+    act = np.zeros((lay.count, k))
+    for j in range(k):
+        act[dofs, j] = np.cross(omega[j], gpos)
+    return act[free]
+
+
 def stability(
     model: Model,
     state: State | None = None,
@@ -158,8 +201,15 @@ def stability(
     state = model.reference_state() if state is None else state
     obj = RodObjective(model, state, supports or Supports(), loads or Loads())
     _, g, H = obj.evaluate(obj.vector(), True, 1)
+    rigid = obj.rigid_modes()
     spec = analyse_hessian(
-        H, obj.metric(), obj.rigid_modes(), count=int(count), modes=True, tol=tol
+        H,
+        obj.metric(),
+        rigid,
+        count=int(count),
+        modes=True,
+        tol=tol,
+        rigid_action=symmetry_action(obj, rigid, g),
     )
     vectors = np.zeros((len(obj.free), 0)) if spec.modes is None else spec.modes
     return StabilityResult(
