@@ -80,14 +80,19 @@ def test_squared_distance_is_the_minimum_over_both_segments(kind):
         assert _d2(x)[0] == pytest.approx(ref, rel=1e-7, abs=1e-12)
 
 
-def _two_segments(kind, rng):
-    """Two 3-node filaments near contact (radius 0.5: contact distance 1.0)."""
+def _two_segments(kind, rng, outside=False):
+    """Two 3-node filaments pressed 0.2-0.4 % into contact (radius 0.5: contact distance 1.0,
+    inside the default barrier's zone) or, with ``outside``, as far apart of it (inside the
+    zone of a barrier with ``offset=0``)."""
+    sign = 1.0 if outside else -1.0
     if kind == "crossing":
         a = np.array([[-1.0, 0.2, 0], [0.1, 0.0, 0], [1.1, -0.1, 0]])
-        b = np.array([[0.2, -1.0, 1.003], [0.0, 0.1, 1.004], [-0.1, 1.0, 1.002]])
+        b = np.array([[0.2, -1.0, 0.003], [0.0, 0.1, 0.004], [-0.1, 1.0, 0.002]])
+        b[:, 2] = 1.0 + sign * b[:, 2]
     else:  # parallel, offset along the axis
         a = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]])
-        b = np.array([[0.4, 1.004, 0.0], [1.4, 1.003, 0.001], [2.4, 1.002, 0.0]])
+        b = np.array([[0.4, 0.004, 0.0], [1.4, 0.003, 0.001], [2.4, 0.002, 0.0]])
+        b[:, 1] = 1.0 + sign * b[:, 1]
     pts = np.vstack([a, b]) + 2e-4 * rng.standard_normal((6, 3))
     printed = pts + np.array([[0, 0, 0]] * 3 + [[0, 0, 5.0]] * 3)  # printed apart: not fused
     return Network(printed, [[0, 1], [1, 2], [3, 4], [4, 5]]), pts
@@ -114,19 +119,20 @@ def _check_potential(pot, x, eps=1e-7):
     assert np.allclose(H, H.T, atol=1e-12 * np.abs(H).max())
 
 
+@pytest.mark.parametrize("offset", [None, 0.0], ids=["default", "outside"])
 @pytest.mark.parametrize("kind", ["crossing", "parallel"])
-def test_self_contact_barrier_matches_finite_differences(kind, rng):
-    net, pts = _two_segments(kind, rng)
-    pot = ContactPotential(Contact(radius=0.5, activation_distance=0.01, stiffness=1.0), net)
-    _check_potential(pot, pts)
+def test_self_contact_barrier_matches_finite_differences(kind, offset, rng):
+    net, pts = _two_segments(kind, rng, outside=offset == 0.0)
+    contact = Contact(radius=0.5, activation_distance=0.01, stiffness=1.0, offset=offset)
+    _check_potential(ContactPotential(contact, net), pts)
 
 
 @pytest.mark.parametrize(
     "obstacle",
-    [
-        Floor(height=-0.505),
-        Sphere(centre=(0.3, 0.0, -2.506), radius=2.0),
-        Cylinder.along((0.4, 0.0, -1.006), (0.1, 1.0, 0.0), radius=0.5, length=10.0),
+    [  # the filament pressed 0.5 % of a radius (0.6 % of r + R) into each, in the zone
+        Floor(height=-0.4975),
+        Sphere(centre=(0.3, 0.0, -2.494), radius=2.0),
+        Cylinder.along((0.4, 0.0, -0.994), (0.1, 1.0, 0.0), radius=0.5, length=10.0),
     ],
     ids=["plane", "sphere", "cylinder"],
 )
@@ -155,7 +161,7 @@ def test_lagged_friction_matches_finite_differences(slip, rng):
     net, pts = _two_segments("crossing", rng)
     contact = Contact(
         radius=0.5,
-        obstacles=(Floor(height=-0.5045),),
+        obstacles=(Floor(height=-0.4955),),
         activation_distance=0.01,
         stiffness=1.0,
         friction=0.5,
@@ -175,7 +181,7 @@ def test_friction_force_is_coulomb_when_sliding_and_smoothed_when_sticking(rng):
     hand-evaluated f1(eps / 2) = 3/4 (an upper bound alone would pass with friction switched
     off or its coefficient halved)."""
     net, pts = _two_segments("crossing", rng)
-    contact = Contact(radius=0.5, obstacles=(Floor(height=-0.5045),), stiffness=1.0)
+    contact = Contact(radius=0.5, obstacles=(Floor(height=-0.4955),), stiffness=1.0)
     pot = ContactPotential(replace(contact, friction=0.3, slip=1e-4), net)
     lag = pot.lag(pts)
     assert lag.normal_force.min() > 0

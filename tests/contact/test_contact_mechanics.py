@@ -47,25 +47,45 @@ def _beam_on_rod(load_factor: float, length: float = 40.0, gap: float = 0.2):
     return model, supports, loads, closing, nb
 
 
-def test_beam_pressed_on_crossing_rod_carries_load_minus_spring_force():
-    model, supports, loads, closing, nb = _beam_on_rod(3.0)
-    contact = Contact(radius=R, activation_distance=2e-3)
-    res = solve_static(model, supports, loads, contact=contact)
-    force = res.contact.forces(res.positions)[:nb, 2].sum()
-    expected = 3.0 * closing - closing  # P - 48 EI delta0 / L^3
+@pytest.mark.parametrize("factor", [1.2, 1.5, 3.0, 6.0])
+def test_beam_pressed_on_crossing_rod_carries_load_minus_spring_force(factor):
+    """At the default contact settings, from 1.2 x the closing load on: the contact force is
+    P - 48 EI delta0 / L^3 within 2 % and the centre lines are r_a + r_b apart within 0.5 %
+    (the beam's deflection is the gap: 1 % of the gap is 5 % of the force at 1.2 x)."""
+    model, supports, loads, closing, nb = _beam_on_rod(factor)
+    res = solve_static(model, supports, loads, contact=Contact(radius=R))
+    forces = res.contact.forces(res.positions)
+    force = forces[:nb, 2].sum()
+    expected = factor * closing - closing  # P - 48 EI delta0 / L^3
     assert force == pytest.approx(expected, rel=0.02)
     # the rod pushes the beam up by exactly what it pushes itself down
-    assert res.contact.forces(res.positions)[nb:, 2].sum() == pytest.approx(-force, rel=1e-9)
-    assert 1.0 < res.contact.clearance(res.positions) < 1.0 + 2e-3 / (2 * R) + 1e-12
+    assert forces[nb:, 2].sum() == pytest.approx(-force, rel=1e-9)
+    assert 1.0 - 5e-3 < res.contact.clearance(res.positions) <= 1.0
     assert res.contact.active_contacts(res.positions) > 0
 
 
-def test_beam_below_the_closing_load_bends_freely():
-    model, supports, loads, _, nb = _beam_on_rod(0.5)
-    res = solve_static(model, supports, loads, contact=Contact(radius=R, activation_distance=2e-3))
+@pytest.mark.parametrize("factor", [0.5, 0.95])
+def test_beam_below_the_closing_load_bends_freely(factor):
+    """Below the closing load nothing touches and nothing pushes: the barrier acts only once
+    the surfaces touch (at 0.95 x they are 1 % of the gap, 0.002 mm, apart)."""
+    model, supports, loads, _, nb = _beam_on_rod(factor)
+    res = solve_static(model, supports, loads, contact=Contact(radius=R))
     deflection = 2 * R + 0.2 - res.positions[nb // 2, 2]
-    assert deflection == pytest.approx(0.1, rel=0.01)  # P L^3 / 48 EI
+    assert deflection == pytest.approx(0.2 * factor, rel=0.01)  # P L^3 / 48 EI
     assert res.contact.active_contacts(res.positions) == 0
+    assert np.all(res.contact.forces(res.positions) == 0.0)
+
+
+def test_a_barrier_outside_the_contact_distance_makes_the_filaments_thicker():
+    """``Contact(offset=0)`` keeps the surfaces strictly apart: the pressed contact settles
+    up to the activation distance outside r_a + r_b, and at 1.2 x the closing load the contact
+    force is too high by several per cent (what the default's offset removes)."""
+    model, supports, loads, closing, nb = _beam_on_rod(1.2)
+    res = solve_static(model, supports, loads, contact=Contact(radius=R, offset=0.0))
+    force = res.contact.forces(res.positions)[:nb, 2].sum()
+    assert force > 1.2 * (0.2 * closing)
+    dhat = res.contact.dhat
+    assert 1.0 < res.contact.clearance(res.positions) < 1.0 + dhat / (2 * R)
 
 
 def _filament(height: float, n: int = 21):
@@ -94,8 +114,10 @@ def test_filament_rests_on_floor_with_reaction_equal_to_buoyant_weight():
     (on_floor,) = res.contact.obstacle_forces(res.positions)
     assert on_floor == pytest.approx(-reaction, rel=1e-9, abs=1e-15)
     assert np.allclose(reaction[:2], 0.0)
+    # the nodes rest in the barrier's zone, which starts where they touch: pressed by their
+    # weight, within 0.5 % of a radius of it
     heights = res.positions[:, 2] - R
-    assert np.all(heights > 0) and np.all(heights < res.contact.dhat)
+    assert np.all(heights < 0) and np.all(heights > -5e-3 * R)
     # frictionless floor: the in-plane rigid motions were removed, not pinned by a support
     assert np.allclose(res.positions[:, :2].mean(0), pts[:, :2].mean(0), atol=1e-9)
 
@@ -130,26 +152,29 @@ def test_interpenetrating_start_is_refused():
 
 
 def test_step_bound_stops_a_tunnelling_step():
-    """Two crossing segments 1.1 apart (contact at 1.0); the step moves one 3 mm through the
-    other, whose end point is again clear: the bound stops it before touching."""
+    """Two crossing segments 1.1 apart (contact at 1.0, the barrier infinite 0.01 inside it);
+    the step moves one 3 mm through the other, whose end point is again clear: the bound stops
+    it before the barrier's wall."""
     net = Network([[-1, 0, 0], [1, 0, 0], [0, -1, 1.1], [0, 1, 1.1]], [[0, 1], [2, 3]])
     pot = ContactPotential(Contact(radius=0.5, activation_distance=0.01), net)
+    assert pot.offset == 0.01
     x = net.nodes.copy()
     dx = np.zeros_like(x)
     dx[2:, 2] = -3.0
     t = pot.step_bound(x, dx)
-    # the gap of 0.1 closes at t = 0.1 / 3: the bound stops just short of it (0.99 of it with
-    # the default close fraction), not anywhere short (a too-timid bound costs Newton steps)
-    assert 0.8 * 0.1 / 3.0 < t < 0.1 / 3.0
-    assert pot.clearance(x + t * dx) > 1.0
+    # the gap of 0.11 to the wall closes at t = 0.11 / 3: the bound stops just short of it (0.9
+    # of it with the default close fraction), not anywhere short (a too-timid bound costs
+    # Newton steps)
+    assert 0.8 * 0.11 / 3.0 < t < 0.11 / 3.0
+    assert pot.clearance(x + t * dx) > 1.0 - 0.01
     assert not pot.path_is_free(x, x + dx)
     assert pot.path_is_free(x, x + 0.5 * t * dx)
     # a node falling onto the floor moves linearly in height: its bound is exactly the close
-    # fraction of its time of impact, (1.0 - r) / 3
+    # fraction of its time of impact with the wall, (1.0 - (r - offset)) / 3
     net = Network([[-1, 0, 1.0], [1, 0, 1.0]], [[0, 1]])
     pot = ContactPotential(Contact(radius=0.5, obstacles=(Floor(),), activation_distance=0.01), net)
     dx = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -3.0]])
-    assert pot.step_bound(net.nodes, dx) == pytest.approx(0.9 * 0.5 / 3.0, rel=1e-12)
+    assert pot.step_bound(net.nodes, dx) == pytest.approx(0.9 * 0.51 / 3.0, rel=1e-12)
 
 
 def test_obstacle_constructors_check_units_and_shapes():
@@ -285,3 +310,25 @@ def test_stiffness_scale_multiplies_the_default_stiffness_only():
     assert soft.kappa == pytest.approx(0.01 * base, rel=1e-15)
     given = Contact(radius=0.1, stiffness=3.0, stiffness_scale=0.01)
     assert ContactPotential(given, net).kappa == 3.0
+
+
+def test_offset_is_checked_and_defaults_to_the_activation_distance():
+    net = Network(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1], [1, 2]]))
+    pot = ContactPotential(Contact(radius=0.1), net)
+    assert pot.dhat == pytest.approx(0.01 * 0.2) and pot.offset == pot.dhat
+    assert ContactPotential(Contact(radius=0.1, offset=0.0), net).offset == 0.0
+    for bad in (-1e-3, 0.1, np.nan):
+        with pytest.raises(InvalidParameterError, match=r"Contact\.offset"):
+            Contact(radius=0.1, offset=bad)
+    # an activation distance beyond the radius would put the default offset's wall below 0
+    with pytest.raises(InvalidParameterError, match=r"Contact\.offset"):
+        ContactPotential(Contact(radius=0.1, activation_distance=0.2), net)
+
+
+def test_pressed_contacts_settle_within_half_a_percent_of_touching():
+    model, supports, loads, _, _ = _beam_on_rod(3.0)
+    res = solve_static(model, supports, loads, contact=Contact(radius=R))
+    ratios = res.contact.contact_ratios(res.positions)
+    assert len(ratios) == res.contact.active_contacts(res.positions) > 0
+    assert np.all((ratios > 1 - 5e-3) & (ratios < 1.0))
+    assert ratios.min() == pytest.approx(res.contact.clearance(res.positions), rel=1e-12)

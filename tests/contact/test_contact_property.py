@@ -1,10 +1,12 @@
-"""Property: no accepted Newton iterate ever brings allowed pairs closer than r_a + r_b."""
+"""Property: no accepted Newton iterate ever brings allowed pairs to where the barrier is infinite
+(``r_a + r_b`` less the contact offset)."""
 
 from __future__ import annotations
 
 from unittest import mock
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -88,8 +90,13 @@ def test_accepted_iterates_never_interpenetrate(seed, chains, push, curl, floor)
     keys = i * ne + j
     allowed = ~np.isin(keys, pot.excluded)
     quads = np.ascontiguousarray(np.hstack([net.edges[i[allowed]], net.edges[j[allowed]]]))
+    # the barrier is infinite 1 % (its offset) inside r_a + r_b: no iterate ever reaches that,
+    # however hard the loads press (up to 20 x the bending force scale here); a pressed
+    # equilibrium settles a fraction of it inside
+    wall = 2 * radius - pot.offset
+    assert pot.offset == pytest.approx(0.01 * 2 * radius)
     for x in seen:
         d = pair_distances(np.ascontiguousarray(x), quads)
-        assert d.min() >= (1 - 1e-3) * 2 * radius
+        assert d.min() > wall
         if floor:
-            assert x[:, 2].min() >= (1 - 1e-3) * radius
+            assert x[:, 2].min() > radius - pot.offset

@@ -50,14 +50,14 @@ def test_energy_only_evaluation_is_the_full_one_to_the_bit(rng, friction):
     """A hairpin filament (two rows side by side) on a floor and under a sphere: self pairs,
     floor nodes, an obstacle point pair and (with friction) the lagged friction all active."""
     half = np.linspace(0.0, 6.0, 12)
-    pts = np.r_[
-        np.c_[half, 0 * half, 0.27 + 0.001 * half],
-        np.c_[half[::-1], 0.53 + 0 * half, 0.28 + 0 * half],
+    pts = np.r_[  # pressed 1-4 % of a radius into the floor, each other and the sphere
+        np.c_[half, 0 * half, 0.23 + 0.001 * half],
+        np.c_[half[::-1], 0.49 + 0 * half, 0.24 + 0 * half],
     ]
     net = Network(pts, np.c_[np.arange(23), np.arange(1, 24)])
     contact = Contact(
         radius=0.25,
-        obstacles=(Floor(height=0.0), Sphere(centre=(3.0, 0.26, 2.04), radius=1.5)),
+        obstacles=(Floor(height=0.0), Sphere(centre=(3.0, 0.245, 1.946), radius=1.5)),
         activation_distance=0.05,
         stiffness=1.0,
         friction=friction,

@@ -1,9 +1,9 @@
 """A lattice resting on the floor under its weight: on a rigid floor the flat resting state is a
 strict local minimum at every actuation (lifting costs weight × height to first order, the
 bending energy released is second order), so following it continuously keeps a dome flat long
-after a lifted dome is lower in energy (here until the barrier's finite stiffness lets go, with
-a snap); the default ramp also looks for a lifted equilibrium and takes it when its total
-energy is lower."""
+after a lifted dome is lower in energy (here to the end of the ramp; with a softer barrier
+until its finite stiffness lets go, with a snap); the default ramp also looks for a lifted
+equilibrium and takes it when its total energy is lower."""
 
 from __future__ import annotations
 
@@ -52,7 +52,8 @@ def test_the_resting_branch_stays_flat_long_after_the_lifted_one_is_lower(ramps,
     assert rest.lift_energy_gap is None
     assert all(rest.stable)  # a certified minimum at every step, not a saddle point
     k = int(np.flatnonzero(best.floor_lift > 2.0 * dome.radius)[0])
-    late = int(np.flatnonzero(rest.floor_lift > 2.0 * dome.radius)[0])
+    lifted = np.flatnonzero(rest.floor_lift > 2.0 * dome.radius)
+    late = int(lifted[0]) if len(lifted) else len(rest.floor_lift)  # (here: never)
     assert late >= k + 3  # flat and stable for three more steps
     assert (rest.gaussian_sign[:late] == 0).all()
     assert (rest.energy[k:late] > best.energy[k:late]).all()
@@ -70,7 +71,7 @@ def test_the_default_takes_the_lifted_dome_where_it_is_lower_in_energy(ramps, do
     # once lifted, it follows the lifted branch: no more probes, never above the resting one
     assert np.isnan(best.lift_energy_gap[k + 1 :]).all()
     assert (best.energy <= rest.energy + 1e-9 * np.abs(rest.energy).max()).all()
-    assert float(best.min_clearance.min()) >= 0.999
+    assert float(best.min_clearance.min()) > 0.995  # pressed contacts: within 0.5 %
 
 
 def test_a_bad_branch_name_is_refused(dome):
@@ -186,8 +187,9 @@ def test_lift_off_and_weightless_buckling_are_bisected_and_ordered(dome, ramps):
         gravity=lattice_gravity(dome),
         lift_off_tolerance=tol,
     )
-    # the same ramp as without refinement
-    np.testing.assert_array_equal(res.positions, ramps["lowest"].positions)
+    # the same ramp as without refinement (to round-off: the contact Hessian's pattern, grown
+    # once per network, has grown in the ramps before this one)
+    np.testing.assert_allclose(res.positions, ramps["lowest"].positions, rtol=0, atol=1e-10)
     (lo, hi), (b_lo, b_hi) = res.lift_off_bracket, res.buckling_bracket
     assert 0 < hi - lo <= tol and 0 < b_hi - b_lo <= tol
     k = int(np.flatnonzero(res.floor_lift > 2.0 * dome.radius)[0])

@@ -1,7 +1,9 @@
 r"""The smoothly clamped log barrier on the squared distance offset by the thickness (compiled).
 
-Symbols: centre-line distance ``d`` of a pair, contact distance :math:`d_{min} = r_a + r_b`
-(the two radii; the filament radius alone against a floor), activation distance
+Symbols: centre-line distance ``d`` of a pair, :math:`d_{min}` the distance at which the barrier
+is infinite (the contact distance :math:`r_a + r_b`, or the filament radius alone against a
+floor, less the contact offset: :mod:`rotomorph.contact.potential` puts the zone inside the
+contact distance, so that it ends where the surfaces touch), activation distance
 :math:`\hat d` (the barrier is zero for :math:`d \ge d_{min} + \hat d`). On the offset squared
 distance :math:`z = d^2 - d_{min}^2` with activation :math:`\hat z = (2 d_{min} + \hat d)\hat d`,
 

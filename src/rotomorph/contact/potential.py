@@ -6,8 +6,14 @@ network and evaluates, on node positions ``x`` (N, 3) in mm,
 * the barrier energy (:mod:`rotomorph.contact.barrier`) of every segment pair allowed to touch
   (:mod:`rotomorph.contact.exclusion`) and of every segment near an obstacle, with its exact
   gradient and Hessian (COO triplets on the position coordinates ``3 i + k``);
-* a provably collision-free step bound along a straight step (:mod:`rotomorph.contact.ccd`);
+* a step bound along a straight step, provably short of where the barrier is infinite
+  (:mod:`rotomorph.contact.ccd`);
 * contact forces, the clearance ``d / (r_a + r_b)`` and the number of active contacts.
+
+The barrier acts in a zone of depth ``d̂`` (the activation distance) that ends where the
+surfaces touch, ``d = r_a + r_b``: it is zero while they are apart and infinite at
+``r_a + r_b - offset`` (``offset = d̂`` by default), so a pressed contact settles a fraction of
+``d̂`` inside touching and the filaments behave as thick as printed.
 
 Obstacle geometry enters as fixed extra points: a sphere is a zero-length segment at its centre
 with contact distance ``r + R``; a cylinder is its axis segment with ``r + R``; a floor is a
@@ -50,8 +56,10 @@ ACTIVATION_FORCE = 1.0
 MAX_SUBSTEPS = 100_000
 #: IPC's edge-edge mollifier threshold relative to ``|a|^2 |b|^2`` (sin² of about 1.8 degrees)
 MOLLIFIER = 1e-3
-#: default activation distance relative to the smallest contact distance
-DEFAULT_ACTIVATION = 0.03
+#: default activation distance relative to the smallest contact distance: the depth of the zone,
+#: ending where the surfaces touch, in which the barrier acts (chosen by measurement,
+#: docs/contact.md: a contact carrying the reference force settles half of it inside touching)
+DEFAULT_ACTIVATION = 0.01
 #: margin of the reused candidate set (Verlet list) relative to the smallest contact distance
 PAD = 1.0
 #: how far (per coordinate, relative to the activation distance) a path's end may leave the
@@ -83,8 +91,16 @@ class Contact:
     self_contact
         Whether segments of the network touch each other (default True).
     activation_distance
-        Gap ``d - (r_a + r_b)`` below which the barrier acts (mm); default 3 % of the smallest
-        contact distance. Equilibrium gaps lie in ``(0, activation_distance)``.
+        Depth ``d̂`` of the zone in which the barrier acts (mm); default 3 % of the smallest
+        contact distance. The zone ends where the surfaces touch (``d = r_a + r_b``) and the
+        barrier is infinite ``offset`` below where it ends, at ``r_a + r_b + d̂ - offset``.
+    offset
+        How far inside ``r_a + r_b`` the barrier is infinite (mm, ``0 <= offset <
+        min(radius)``); default the activation distance: the barrier acts from the moment the
+        surfaces touch, a pressed contact settles at ``r_a + r_b`` less a fraction of ``d̂``
+        (none before touching) and no pair comes closer than ``r_a + r_b - d̂``. With 0
+        the surfaces never overlap, and a pressed contact settles up to ``d̂`` apart (the
+        filaments behave thicker by up to ``d̂``).
     stiffness
         Barrier stiffness κ (N/mm⁵); default: chosen by the solver from the problem's force
         scale so that a pair at half the activation distance carries a typical nodal force.
@@ -106,6 +122,7 @@ class Contact:
     self_contact: bool = True
     activation_distance: float | None = None
     stiffness: float | None = None
+    offset: float | None = None
     stiffness_scale: float = 1.0
     reach: float | None = None
     friction: float = 0.0
@@ -128,6 +145,14 @@ class Contact:
             v = getattr(self, name)
             if v is not None and not (np.isfinite(v) and v > 0):
                 raise InvalidParameterError(f"Contact.{name}", f"must be > 0 or None; got {v}")
+        if self.offset is not None and not (
+            np.isfinite(self.offset) and 0 <= self.offset < float(r.min())
+        ):
+            raise InvalidParameterError(
+                "Contact.offset",
+                f"must be >= 0 mm and below the smallest radius {float(r.min()):.4g} mm "
+                f"(None: the activation distance); got {self.offset}",
+            )
         if not (np.isfinite(self.stiffness_scale) and self.stiffness_scale > 0):
             raise InvalidParameterError(
                 "Contact.stiffness_scale",
@@ -166,7 +191,7 @@ class _Candidates:
     """Pairs near contact at one configuration (indices into the extended point array)."""
 
     quads: IntArray  # (P, 4) p0 p1 q0 q1 (p0 = p1: a node against a segment)
-    dmin: FloatArray
+    dmin: FloatArray  # where the barrier is infinite: the contact distance less the offset
     weight: FloatArray
     mollify: FloatArray  # edge-edge mollifier threshold (0: none)
     floors: tuple[tuple[IntArray, FloatArray, FloatArray], ...]  # per floor: nodes, dmin, weight
@@ -280,6 +305,13 @@ class ContactPotential:
         self.node_length = vor
         dmin_small = 2.0 * float(self.radius.min())
         self.dhat = float(contact.activation_distance or DEFAULT_ACTIVATION * dmin_small)
+        self.offset = self.dhat if contact.offset is None else float(contact.offset)
+        if self.offset >= float(self.radius.min()):
+            raise InvalidParameterError(
+                "Contact.offset",
+                f"the offset {self.offset:.4g} mm (default: the activation distance) must be "
+                f"below the smallest radius {float(self.radius.min()):.4g} mm",
+            )
         self.slip = float(contact.slip or 1e-3 * dmin_small)
         self.excluded = (
             _excluded(network, edges, self.radius, self.dhat, contact.reach)
@@ -302,12 +334,14 @@ class ContactPotential:
         if contact.stiffness is not None:
             self.kappa = float(contact.stiffness)
         else:
-            # a pair at gap dhat/2 carries force_scale: F = kappa w |b'(zhat/2)| 2 dmin with
-            # |b'(zhat/2)| = (1/2 + ln 2) zhat  (barrier module)
+            # a pair at half the activation distance carries force_scale:
+            # F = kappa w |b'(zhat/2)| 2 d with |b'(zhat/2)| = (1/2 + ln 2) zhat  (barrier
+            # module), d the barrier's own contact distance
             w = float(np.median(length))
-            zhat = (2.0 * dmin_small + self.dhat) * self.dhat
+            wall = dmin_small - self.offset
+            zhat = (2.0 * wall + self.dhat) * self.dhat
             self.kappa = contact.stiffness_scale * float(
-                ACTIVATION_FORCE * force_scale / (w * (0.5 + np.log(2.0)) * zhat * 2 * dmin_small)
+                ACTIVATION_FORCE * force_scale / (w * (0.5 + np.log(2.0)) * zhat * 2 * wall)
             )
         self._max_length = float(length.max())
         self._dmin_max = 2.0 * float(self.radius.max())
@@ -477,7 +511,7 @@ class ContactPotential:
             L = self.length
             add(
                 np.concatenate([edges[k], edges[j]], axis=1),
-                self.radius[k] + self.radius[j],
+                self.radius[k] + self.radius[j] - self.offset,
                 0.5 * (L[k] + L[j]),
                 MOLLIFIER * (L[k] * L[j]) ** 2,
             )
@@ -485,7 +519,7 @@ class ContactPotential:
             node, seg = ns[:, 0], ns[:, 1]
             add(
                 np.stack([node, node, edges[seg, 0], edges[seg, 1]], axis=1),
-                self.node_radius[node] + self.radius[seg],
+                self.node_radius[node] + self.radius[seg] - self.offset,
                 self.node_length[node],
                 np.zeros(len(node)),
             )
@@ -504,7 +538,7 @@ class ContactPotential:
             axis2 = float(np.sum((b - a) ** 2))
             add(
                 np.concatenate([edges[near], np.tile(q, (len(near), 1))], axis=1),
-                self.radius[near] + o.radius,
+                self.radius[near] + o.radius - self.offset,
                 self.length[near],
                 MOLLIFIER * self.length[near] ** 2 * axis2,
             )
@@ -514,7 +548,7 @@ class ContactPotential:
                     np.stack(
                         [nodes, nodes, np.full(len(nodes), q[0]), np.full(len(nodes), q[1])], 1
                     ),
-                    self.node_radius[nodes] + o.radius,
+                    self.node_radius[nodes] + o.radius - self.offset,
                     self.node_length[nodes],
                     np.zeros(len(nodes)),
                 )
@@ -525,7 +559,7 @@ class ContactPotential:
             floors.append(
                 (
                     np.ascontiguousarray(near, dtype=np.int64),
-                    np.ascontiguousarray(self.node_radius[near]),
+                    np.ascontiguousarray(self.node_radius[near] - self.offset),
                     np.ascontiguousarray(self.node_length[near]),
                 )
             )
@@ -720,6 +754,11 @@ class ContactPotential:
     def distances(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Centre-line distances of the candidate pairs near contact and their contact
         distances ``r_a + r_b`` (mm); floors as node heights and radii."""
+        d, wall = self._distances(x)
+        return d, wall + self.offset
+
+    def _distances(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """:meth:`distances` with the distances at which the barrier is infinite."""
         x = np.ascontiguousarray(x, dtype=float)
         cand = self.candidates(x, margin=self._dmin_max)
         d = pair_distances(self._extended(x), cand.quads)
@@ -728,26 +767,36 @@ class ContactPotential:
         return dist, np.concatenate([cand.dmin, cand.floor_dmin])
 
     def clearance(self, x: FloatArray) -> float:
-        """Smallest ``d / (r_a + r_b)`` over allowed pairs and obstacles (2.0 when none is near)."""
+        """Smallest ``d / (r_a + r_b)`` over allowed pairs and obstacles (2.0 when none is near;
+        below 1 by less than ``offset / (r_a + r_b)`` for a pressed contact)."""
         d, dmin = self.distances(x)
         return float(min(2.0, (d / dmin).min())) if len(d) else 2.0
 
+    def contact_ratios(self, x: FloatArray) -> FloatArray:
+        """``d / (r_a + r_b)`` of every pair (and floor node: height over radius) carrying
+        contact force, i.e. inside the barrier's zone: how far pressed contacts are from just
+        touching (1; with the default offset in ``(1 - offset / (r_a + r_b), 1)``)."""
+        d, wall = self._distances(x)
+        on = d < wall + self.dhat
+        return np.asarray(d[on] / (wall[on] + self.offset))
+
     def active_contacts(self, x: FloatArray) -> int:
         """Pairs (and floor nodes) inside the activation distance (carrying force)."""
-        d, dmin = self.distances(x)
-        return int(np.count_nonzero(d < dmin + self.dhat))
+        d, wall = self._distances(x)
+        return int(np.count_nonzero(d < wall + self.dhat))
 
     def check_admissible(self, x: FloatArray, field: str = "initial") -> None:
-        """Raise :class:`InfeasibleContactError` if ``x`` touches or interpenetrates."""
-        d, dmin = self.distances(x)
+        """Raise :class:`InfeasibleContactError` if ``x`` reaches where the barrier is infinite
+        (``r_a + r_b - offset``; a pressed contact of an earlier equilibrium lies above it)."""
+        d, dmin = self._distances(x)
         bad = np.flatnonzero(d <= dmin)
         if len(bad):
             k = int(bad[np.argmin((d / dmin)[bad])])
             raise InfeasibleContactError(
                 field,
-                f"{len(bad)} contact pair(s) already touch or interpenetrate (closest at "
-                f"{d[k]:.4g} mm < {dmin[k]:.4g} mm); start from a separated configuration, move "
-                "the obstacles away, or widen Contact.reach",
+                f"{len(bad)} contact pair(s) already interpenetrate (closest at {d[k]:.4g} mm, "
+                f"not above {dmin[k]:.4g} mm = r_a + r_b - Contact.offset); start from a "
+                "separated configuration, move the obstacles away, or widen Contact.reach",
             )
 
 

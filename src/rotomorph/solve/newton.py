@@ -329,8 +329,12 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 continue
         alpha = min(1.0, obj.max_step(x, d))
         accepted = False
+        # largest change of an unknown along the step (mm or rad): a nearly singular direction
+        # (a free body's fall onto a floor it does not touch yet) makes the shifted step huge,
+        # and the step bound's fraction of it tiny although it moves the body by a gap
+        reach = float(np.max(np.abs(d), initial=0.0))
         for _ in range(opt.max_backtracks):
-            if alpha < 1e-10:  # a step this short changes nothing in floating point
+            if alpha < 1e-10 and alpha * reach < 1e-8:  # a step this short changes nothing
                 break
             xt = obj.retract(x, d, alpha)
             ft = obj.evaluate(xt, False, False)[0]
