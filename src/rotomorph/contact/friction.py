@@ -26,7 +26,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray, IntArray
 
-__all__ = ["FrictionLag", "friction_energy", "mollifier"]
+__all__ = ["FrictionLag", "friction_energy", "lag_change", "mollifier"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,5 +104,28 @@ def friction_energy(
             "ki,kj->kij", uhat, uhat
         )
         Hu *= c[:, None, None]
-        hloc = np.einsum("kim,kij,kjn->kmn", J, Hu, J)
+        hloc = np.transpose(J, (0, 2, 1)) @ Hu @ J  # J^T Hu J per contact
     return energy, grad, hloc
+
+
+def _normal_forces(lag: FrictionLag) -> FloatArray:
+    """Each lagged contact's normal force vector ``lambda n`` ``(K, 3)`` (N; ``n`` the normal the
+    right-handed tangent basis is taken about)."""
+    return lag.normal_force[:, None] * np.cross(lag.bases[:, :, 0], lag.bases[:, :, 1])
+
+
+def lag_change(old: FrictionLag, new: FrictionLag) -> float:
+    """How much the lagged normal forces and normals changed from ``old`` to ``new``
+    (dimensionless): ``sum_k |lambda_k n_k (new) - lambda_k n_k (old)|`` over the larger total
+    lagged force, contacts matched by their nodes (one lagged in only one of the two counts with
+    its whole force). 0 when nothing is lagged in either. The tangent plane is the one normal
+    to ``n`` whatever its in-plane basis, so the normal force vector holds everything the
+    friction potential depends on besides the closest points."""
+    total = max(float(old.normal_force.sum()), float(new.normal_force.sum()))
+    if total == 0.0:
+        return 0.0
+    keys, index = np.unique(np.concatenate([old.nodes, new.nodes]), axis=0, return_inverse=True)
+    diff = np.zeros((len(keys), 3))
+    np.add.at(diff, index.reshape(-1)[: old.count], -_normal_forces(old))
+    np.add.at(diff, index.reshape(-1)[old.count :], _normal_forces(new))
+    return float(np.linalg.norm(diff, axis=1).sum()) / total

@@ -45,7 +45,6 @@ from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
-from rotomorph.geometry import plane_basis
 
 __all__ = ["Contact", "ContactPotential", "HessianBlocks", "InfeasibleContactError"]
 
@@ -115,6 +114,12 @@ class Contact:
     slip
         Tangential displacement (mm) over which lagged friction ramps from sticking to sliding
         (IPC's ε_v for a quasi-static step); default 1e-3 of the smallest contact distance.
+    friction_lag
+        The lagged friction of a solve (:meth:`ContactPotential.lag`): its normal forces,
+        closest points and tangent bases, and the start its slips are measured from. Default
+        None: lagged at the solve's initial state, which is also the start. A heating ramp
+        passes the lag re-evaluated at the last solution, with the step's start kept, until
+        it no longer changes (:func:`rotomorph.lattice.heating.heat_lattice`).
     """
 
     radius: float | Sequence[float] | FloatArray
@@ -127,6 +132,7 @@ class Contact:
     reach: float | None = None
     friction: float = 0.0
     slip: float | None = None
+    friction_lag: FrictionLag | None = field(default=None, repr=False, compare=False)
     _radius: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -161,6 +167,16 @@ class Contact:
         if not (np.isfinite(self.friction) and self.friction >= 0):
             raise InvalidParameterError(
                 "Contact.friction", f"must be >= 0 (0: frictionless); got {self.friction}"
+            )
+        if self.friction_lag is not None and not (
+            isinstance(self.friction_lag, FrictionLag)
+            and self.friction > 0
+            and self.friction_lag.coefficient == self.friction
+        ):
+            raise InvalidParameterError(
+                "Contact.friction_lag",
+                "must be a FrictionLag of these settings (ContactPotential.lag) and needs "
+                "friction > 0; None lags at the initial state",
             )
 
     def radii(self, n_edges: int) -> FloatArray:
@@ -368,53 +384,72 @@ class ContactPotential:
     # ------------------------------------------------------------------ friction
     def set_lag(self, x0: FloatArray) -> None:
         """Lag friction at ``x0`` (the previous equilibrium): normal forces, closest points
-        and tangent bases of every contact carrying force are frozen for the next solve.
-        Without friction (μ = 0) this does nothing."""
-        self._lag = None if self.contact.friction == 0 else self.lag(x0)
+        and tangent bases of every contact carrying force are frozen for the next solve, and
+        slips are measured from ``x0``; or the settings' own ``friction_lag``. Without
+        friction (μ = 0) this does nothing."""
+        if self.contact.friction == 0:
+            self._lag = None
+        elif self.contact.friction_lag is not None:
+            lag = self.contact.friction_lag
+            if lag.start.shape != (self.n_nodes + len(self._obstacle_points), 3):
+                raise InvalidParameterError(
+                    "Contact.friction_lag", "was lagged on another network or other obstacles"
+                )
+            self._lag = lag
+        else:
+            self._lag = self.lag(x0)
 
-    def lag(self, x0: FloatArray) -> FrictionLag:
-        """The :class:`~rotomorph.contact.friction.FrictionLag` of configuration ``x0``."""
+    @property
+    def friction_lag(self) -> FrictionLag | None:
+        """The lagged friction of the current solve (None without friction)."""
+        return self._lag
+
+    def lag(self, x0: FloatArray, at: FloatArray | None = None) -> FrictionLag:
+        """The :class:`~rotomorph.contact.friction.FrictionLag` of configuration ``at``
+        (default ``x0``) with slips measured from ``x0``: the contacts carrying force at
+        ``at``, their normal forces, closest points and tangent bases there (IPC's lagged
+        quantities, re-evaluated at the last solution of a step while its start is kept)."""
         x0 = np.ascontiguousarray(x0, dtype=float)
+        start = self._extended(x0).copy()  # kept by the lag
+        if at is not None:
+            x0 = np.ascontiguousarray(at, dtype=float)
         cand = self.candidates(x0)
-        xe = self._extended(x0).copy()  # kept by the lag
-        nodes, weights, bases, force = [], [], [], []
-        near = pair_distances(xe, cand.quads) < cand.dmin + self.dhat
-        for p in np.flatnonzero(near):
-            i0, i1, j0, j1 = cand.quads[p]
-            s, t = closest_parameters(xe[i0], xe[i1], xe[j0], xe[j1])
-            w = np.array([1.0 - s, s, -(1.0 - t), -t])
-            r = w @ xe[[i0, i1, j0, j1]]
-            d = float(np.linalg.norm(r))
-            lam = self._normal_force(d, float(cand.dmin[p]), float(cand.weight[p]))
-            if lam > 0:
-                nodes.append([i0, i1, j0, j1])
-                weights.append(w)
-                bases.append(plane_basis(r / d))
-                force.append(lam)
+        xe = self._extended(x0)
+        near = np.flatnonzero(pair_distances(xe, cand.quads) < cand.dmin + self.dhat)
+        quads = cand.quads[near]
+        st = np.array([closest_parameters(xe[i], xe[j], xe[k], xe[m]) for i, j, k, m in quads])
+        st = st.reshape(-1, 2)
+        w = np.stack([1.0 - st[:, 0], st[:, 0], -(1.0 - st[:, 1]), -st[:, 1]], axis=1)
+        r = np.einsum("pn,pnk->pk", w, xe[quads])
+        d = np.linalg.norm(r, axis=1)
+        lam = self._normal_forces(d, cand.dmin[near], cand.weight[near])
+        on = lam > 0
+        nodes, weights, force = [quads[on]], [w[on]], [lam[on]]
+        normals = [r[on] / d[on, None]]
         for f, (fn, fd, fw) in zip(self._floors, cand.floors, strict=True):
-            h = f.height_of(x0[fn])
-            for k in range(len(fn)):
-                lam = self._normal_force(float(h[k]), float(fd[k]), float(fw[k]))
-                if lam > 0:
-                    nodes.append([fn[k]] * 4)
-                    weights.append(np.array([1.0, 0.0, 0.0, 0.0]))
-                    bases.append(plane_basis(np.asarray(f.normal)))
-                    force.append(lam)
+            lam = self._normal_forces(f.height_of(x0[fn]), fd, fw)
+            on = lam > 0
+            nodes.append(np.repeat(fn[on, None], 4, axis=1))
+            weights.append(np.tile([1.0, 0.0, 0.0, 0.0], (int(on.sum()), 1)))
+            force.append(lam[on])
+            normals.append(np.tile(np.asarray(f.normal, dtype=float), (int(on.sum()), 1)))
+        bases = _plane_bases(np.concatenate(normals))
         return FrictionLag(
-            nodes=np.array(nodes, dtype=np.int64).reshape(-1, 4),
-            weights=np.array(weights, dtype=float).reshape(-1, 4),
-            bases=np.array(bases, dtype=float).reshape(-1, 3, 2),
-            normal_force=np.array(force, dtype=float),
-            start=xe,
+            nodes=np.ascontiguousarray(np.concatenate(nodes), dtype=np.int64).reshape(-1, 4),
+            weights=np.concatenate(weights).reshape(-1, 4),
+            bases=bases,
+            normal_force=np.concatenate(force),
+            start=start,
             coefficient=float(self.contact.friction),
             slip=self.slip,
         )
 
-    def _normal_force(self, d: float, dmin: float, weight: float) -> float:
-        """Barrier force magnitude ``kappa w |b'(z)| 2 d`` of a pair at distance ``d`` (N)."""
+    def _normal_forces(self, d: FloatArray, dmin: FloatArray, weight: FloatArray) -> FloatArray:
+        """Barrier force magnitudes ``kappa w |b'(z)| 2 d`` of pairs at distances ``d`` (N)."""
         zhat = (2.0 * dmin + self.dhat) * self.dhat
-        _, b1, _ = barrier(d * d - dmin * dmin, zhat)
-        return float(self.kappa * weight * -b1 * 2.0 * d)
+        z = d * d - dmin * dmin
+        slope = np.array([barrier(zk, hk)[1] for zk, hk in zip(z, zhat, strict=True)])
+        return np.asarray(self.kappa * weight * -slope.reshape(-1) * 2.0 * d)
 
     # ------------------------------------------------------------------ candidates
     def _extended(self, x: FloatArray) -> FloatArray:
@@ -815,6 +850,17 @@ def _excluded(
     if key not in per:
         per[key] = excluded_pairs(network.nodes, edges, radius, dhat, reach)
     return per[key]  # type: ignore[no-any-return]
+
+
+def _plane_bases(normals: FloatArray) -> FloatArray:
+    """:func:`rotomorph.geometry.plane_basis` of each unit normal ``(K, 3) -> (K, 3, 2)``, with
+    the same choice of first axis."""
+    n = np.asarray(normals, dtype=float).reshape(-1, 3)
+    a = np.cross(n, [1.0, 0.0, 0.0])
+    flat = np.linalg.norm(a, axis=1) < 0.5
+    a[flat] = np.cross(n[flat], [0.0, 1.0, 0.0])
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    return np.stack([a, np.cross(n, a)], axis=2)
 
 
 def _largest_norm(v: FloatArray) -> float:

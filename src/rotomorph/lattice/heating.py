@@ -68,12 +68,15 @@ from rotomorph.solve.stability import StabilityResult, stability
 from rotomorph.solve.static import StaticResult, solve_static
 
 __all__ = [
+    "FRICTION_LAG_TOL",
+    "FRICTION_RELAGS",
     "HeatingResult",
     "free_edge_ratio",
     "fused_pairs",
     "heat_lattice",
     "lattice_gravity",
     "perturbed_state",
+    "relag_friction",
     "segment_clearance",
 ]
 
@@ -89,6 +92,7 @@ SupportsName = Literal["free", "clamped-boundary", "pinned-centre"]
 
 #: Phase messages of long lattice runs (a command line shows them; silent by default).
 phase_log = logging.getLogger("rotomorph.progress")
+logger = logging.getLogger(__name__)
 
 
 def perturbed_state(model: Model, dz: FloatArray, base: State | None = None) -> State:
@@ -474,7 +478,10 @@ def heat_lattice(
         contact on. On a floor, a free lattice keeps only its in-plane rigid motions free
         (they are removed from every Newton step).
     friction
-        Coulomb coefficient of every contact (lagged per ramp step; default 0).
+        Coulomb coefficient of every contact (default 0). Lagged as in IPC: within each
+        ramp step the normal forces, closest points and tangent bases are re-evaluated at the
+        last solution and the step solved again from its own start until they no longer
+        change (:func:`relag_friction`).
     branch
         Which equilibrium a lattice resting on a floor under its weight follows.
         ``"continuous"``: the one reached continuously from the previous step. On a rigid
@@ -589,6 +596,9 @@ def heat_lattice(
         try:
             loads = loads_at(p)
             res = solve_static(model, sup, loads, initial=state, options=options, contact=settings)
+            if settings is not None and settings.friction:
+                res, its = relag_friction(model, sup, loads, state, res, settings, options)
+                events.append((p, its, False))  # the earlier lags' solves count toward it
         except ConvergenceError as err:
             events.append((p, int(getattr(err.result, "iterations", 0)), False))
             raise
@@ -1049,6 +1059,70 @@ def _stable_flag(result: StaticResult) -> bool | None:
     that ends on an unstable point raises, so ``stable=False`` on a returned result means the
     check was switched off, not that the state is unstable."""
     return True if getattr(result, "stable", None) is True else None
+
+
+#: Re-lagged solves of a ramp step with friction before it counts as not converged, and the
+#: change of the lagged normal forces (``rotomorph.contact.friction.lag_change``) below which
+#: the lag has converged
+FRICTION_RELAGS = 30
+FRICTION_LAG_TOL = 1e-3
+
+
+def relag_friction(
+    model: Model,
+    supports: Supports,
+    loads: Loads,
+    start: State,
+    res: StaticResult,
+    settings: Contact,
+    options: NewtonOptions | None,
+) -> tuple[StaticResult, int]:
+    """IPC's outer loop for lagged friction within one load step.
+
+    ``res`` was solved from ``start`` with friction lagged there: the normal forces, closest
+    points and tangent bases of the contacts at the step's start. A contact that closes or
+    presses harder during the step (a lattice settling onto the floor, filaments jamming)
+    then carries no friction, or too little. So the lag is re-evaluated at the solution, slips
+    still measured from ``start``, and the step solved again from the solution, until the
+    lagged normal forces and normals change by less than :data:`FRICTION_LAG_TOL` of their
+    total (Li et al., "Incremental Potential Contact", ACM TOG 39(4) 49, 2020, § 5: the
+    lagged friction converges to the frictional contact solution as these iterations do).
+    Returns the last solve and the Newton iterations of those before it.
+
+    Raises
+    ------
+    ConvergenceError
+        If the lag has not converged after :data:`FRICTION_RELAGS` solves (the ramp's
+        continuation then halves the step).
+    """
+    from dataclasses import replace
+
+    from rotomorph.contact.friction import lag_change
+
+    spent = 0
+    for k in range(FRICTION_RELAGS):
+        pot = res.contact
+        assert pot is not None  # solved with contact settings
+        used = pot.friction_lag
+        new = pot.lag(start.positions, at=res.positions)
+        change = 0.0 if used is None else lag_change(used, new)
+        logger.debug("friction lag %d: change %.3g", k, change)
+        if change <= FRICTION_LAG_TOL:
+            return res, spent
+        spent += res.iterations
+        res = solve_static(
+            model,
+            supports,
+            loads,
+            initial=res.state,
+            options=options,
+            contact=replace(settings, friction_lag=new),
+        )
+    raise ConvergenceError(
+        f"lagged friction did not converge within {FRICTION_RELAGS} solves of one ramp step "
+        f"(normal forces still changing by {change:.3g} of their total); take smaller steps",
+        result=None,
+    )
 
 
 def contact_settings(
