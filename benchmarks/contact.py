@@ -3,10 +3,7 @@
 One line per case with ``case``, ``n_nodes``, ``wall_s``, ``cpu_s`` (this process's CPU time:
 the cost on one core, whatever the load), ``newton_iterations``,
 ``min_clearance_ratio`` (smallest centre-line distance over ``r_a + r_b`` of the pairs allowed
-to touch, over every ramp step), ``contacts_active`` (at the end),
-``contact_distance_ratio`` (``[min, max]`` of ``d / (r_a + r_b)`` over the contacts carrying
-force at the end: how far pressed contacts are from just touching; null when none),
-``stable`` and, for
+to touch, over every ramp step), ``contacts_active`` (at the end), ``stable`` and, for
 lattices, ``area_ratio`` and ``gaussian_sign``:
 
 * ``contracting-5x5``, ``dome-5x5``, ``saddle-5x5``: the paper's 5 x 5 lattices, 16-step ramp
@@ -34,7 +31,7 @@ import time
 
 import numpy as np
 
-from rotomorph.contact import Contact, ContactPotential
+from rotomorph.contact import Contact
 from rotomorph.design.lattices import sinusoidal_lattice
 from rotomorph.lattice import heat_lattice
 from rotomorph.lattice.heating import lattice_buoyancy
@@ -45,11 +42,6 @@ from rotomorph.solve.static import solve_static
 
 def _emit(row: dict) -> None:
     print(json.dumps(row), flush=True)
-
-
-def _contact_distance(pot, x) -> list[float] | None:  # type: ignore[no-untyped-def]
-    ratios = pot.contact_ratios(x)
-    return [round(float(ratios.min()), 5), round(float(ratios.max()), 5)] if len(ratios) else None
 
 
 def _stable(res) -> bool | None:  # type: ignore[no-untyped-def]
@@ -74,9 +66,6 @@ def lattice_case(pattern: str, steps: int) -> dict:
         "newton_iterations": int(res.total_iterations),
         "min_clearance_ratio": round(float(res.min_clearance.min()), 5),
         "contacts_active": int(res.contacts_active[-1]),
-        "contact_distance_ratio": _contact_distance(
-            ContactPotential(res.contact, lat.network), res.positions[-1]
-        ),
         "stable": _stable(res),
         "area_ratio": round(float(res.area_ratio[-1]), 4),
         "gaussian_sign": int(res.gaussian_sign[-1]),
@@ -94,6 +83,7 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
     c0, t0 = time.process_time(), time.perf_counter()
     sim = simulate_filament(program, steps=steps, contact=contact)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    from rotomorph.contact import ContactPotential
     from rotomorph.design.network import Network
 
     pot = ContactPotential(contact, Network.chain(np.asarray(program.points, float)))
@@ -106,7 +96,6 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
         "newton_iterations": int(sim.iterations.sum()),
         "min_clearance_ratio": round(min(pot.clearance(p) for p in sim.positions), 5),
         "contacts_active": int(pot.active_contacts(sim.positions[-1])),
-        "contact_distance_ratio": _contact_distance(pot, sim.positions[-1]),
         "stable": _stable(sim),
         "end_to_end_ratio": round(float(sim.final_ratio), 4),
     }
@@ -133,7 +122,6 @@ def euler_case() -> dict:
         "newton_iterations": int(res.iterations),
         "min_clearance_ratio": round(float(res.contact.clearance(res.positions)), 5),
         "contacts_active": int(res.contact.active_contacts(res.positions)),
-        "contact_distance_ratio": _contact_distance(res.contact, res.positions),
         "stable": bool(res.stable),
         "buckled": bool(np.hypot(tip[1], tip[2]) > 0.01 * case.length),
         "tip_lateral_ratio": round(float(np.hypot(tip[1], tip[2]) / case.length), 4),
