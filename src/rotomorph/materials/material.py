@@ -1,24 +1,24 @@
-"""Materials as data: the inks of a Janus filament and a name registry.
+"""Inks of a Janus filament as values, and the name registry of the default inks.
 
 The two inks of the seed paper (Abdelrahman et al., "Rotational 3D printing of active-passive
-filaments and lattices with programmable shape morphing") ship in ``data/materials.csv`` with
-their measured values and a ``source`` per row; every value that is *not* measured is listed in
-``assumptions``. Stiffer passive blends (paper, Methods: stiffer ink : passive ink = 1:10 and
-1:4) have no measured modulus; :func:`blend_material` derives a placeholder by a stated mixing
-rule from a *user-supplied* stiff-ink modulus.
+filaments and lattices with programmable shape morphing") ship as the default materials file
+``data/paper_inks.toml`` (:mod:`rotomorph.materials.parameter_set`), every value with its unit
+and provenance; a :class:`Material` is one ink's values at the print temperature, with the
+sources and the assumptions listed. Stiffer passive blends (paper, Methods: stiffer ink :
+passive ink = 1:10 and 1:4) have no measured modulus; :func:`blend_material` derives a
+placeholder by a stated mixing rule from a *user-supplied* stiff-ink modulus.
 
 Registry: :func:`get_material`, :func:`register_material`, :func:`known_materials`.
-Built-in names: ``"lce"`` (active), ``"acrylate"`` (passive), ``"acrylate_1to10"`` and
-``"acrylate_1to4"`` (placeholder blends, see :data:`PLACEHOLDER_STIFF_INK_MODULUS`).
+Built-in names: the default file's ``"lce"`` (active) and ``"acrylate"`` (passive), and
+``"acrylate_1to10"`` and ``"acrylate_1to4"`` (placeholder blends, see
+:data:`PLACEHOLDER_STIFF_INK_MODULUS`). A lab's own inks live in its own materials file, named
+by its designs (``materials = "inks.toml"``), not in this registry.
 """
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass, field
-from importlib import resources
 from typing import Literal
 
 from rotomorph.errors import MaterialError
@@ -53,7 +53,7 @@ class Material:
     poisson_ratio
         Poisson ratio ν in (-1, 0.5] (dimensionless); shear modulus G = E / (2 (1 + ν)).
     glass_transition
-        Glass-transition temperature T_g (°C).
+        Glass-transition temperature T_g (°C); ``None`` when not known.
     transition_temperature
         Nematic-to-isotropic temperature T_NI (°C); ``None`` when unknown or not applicable.
     actuation_length
@@ -79,7 +79,7 @@ class Material:
     kind: Kind
     youngs_modulus: float
     poisson_ratio: float
-    glass_transition: float
+    glass_transition: float | None
     transition_temperature: float | None
     actuation_length: float
     density: float
@@ -98,9 +98,10 @@ class Material:
         _check_finite("Material.youngs_modulus", self.youngs_modulus, positive=True)
         _check_finite("Material.actuation_length", self.actuation_length, positive=True)
         _check_finite("Material.density", self.density, positive=True)
-        _check_finite("Material.glass_transition", self.glass_transition)
-        if self.glass_transition < -273.15:
-            raise MaterialError("Material.glass_transition", "must be >= -273.15 °C")
+        if self.glass_transition is not None:
+            _check_finite("Material.glass_transition", self.glass_transition)
+            if self.glass_transition < -273.15:
+                raise MaterialError("Material.glass_transition", "must be >= -273.15 °C")
         _check_finite("Material.poisson_ratio", self.poisson_ratio)
         if not -1.0 < self.poisson_ratio <= 0.5:
             raise MaterialError(
@@ -148,29 +149,6 @@ class Material:
         if measure == "engineering":
             return self.actuation_length - 1.0
         raise MaterialError("measure", f"must be 'hencky' or 'engineering'; got {measure!r}")
-
-
-def _load_builtin() -> dict[str, Material]:
-    text = resources.files("rotomorph.materials").joinpath("data/materials.csv").read_text("utf-8")
-    out: dict[str, Material] = {}
-    for row in csv.DictReader(io.StringIO(text)):
-        tnis = row["transition_temperature"].strip()
-        mat = Material(
-            name=row["name"],
-            kind=row["kind"],  # type: ignore[arg-type]
-            youngs_modulus=float(row["youngs_modulus"]),
-            youngs_modulus_spread=float(row["youngs_modulus_spread"]),
-            poisson_ratio=float(row["poisson_ratio"]),
-            glass_transition=float(row["glass_transition"]),
-            transition_temperature=float(tnis) if tnis else None,
-            actuation_length=float(row["actuation_length"]),
-            actuation_length_spread=float(row["actuation_length_spread"]),
-            density=float(row["density"]),
-            source=(row["source"],),
-            assumptions=tuple(a.strip() for a in row["assumptions"].split("|") if a.strip()),
-        )
-        out[mat.name] = mat
-    return out
 
 
 def blend_material(
@@ -258,7 +236,9 @@ def blend_material(
 
 
 def _builtin_registry() -> dict[str, Material]:
-    reg = _load_builtin()
+    from rotomorph.materials.parameter_set import default_materials  # it builds Materials
+
+    reg = default_materials().materials
     base = reg["acrylate"]
     for parts in (10, 4):
         blend = blend_material(base, PLACEHOLDER_STIFF_INK_MODULUS, 1, parts)
@@ -266,12 +246,19 @@ def _builtin_registry() -> dict[str, Material]:
     return reg
 
 
-_REGISTRY: dict[str, Material] = _builtin_registry()
+_REGISTRY: dict[str, Material] = {}
+
+
+def _registry() -> dict[str, Material]:
+    """The registry, filled with the default inks on first use."""
+    if not _REGISTRY:
+        _REGISTRY.update(_builtin_registry())
+    return _REGISTRY
 
 
 def known_materials() -> tuple[str, ...]:
     """Names of all registered materials, sorted."""
-    return tuple(sorted(_REGISTRY))
+    return tuple(sorted(_registry()))
 
 
 def get_material(name: str) -> Material:
@@ -284,7 +271,7 @@ def get_material(name: str) -> Material:
     """
     key = str(name).strip().lower()
     try:
-        return _REGISTRY[key]
+        return _registry()[key]
     except KeyError:
         raise MaterialError(
             "material",
@@ -304,7 +291,7 @@ def register_material(material: Material, *, overwrite: bool = False) -> Materia
     if not isinstance(material, Material):
         raise MaterialError("register_material.material", "must be a Material instance")
     key = material.name.lower()
-    if key in _REGISTRY and not overwrite:
+    if key in _registry() and not overwrite:
         raise MaterialError(
             "register_material.material",
             f"{key!r} is already registered; pass overwrite=True to replace it",

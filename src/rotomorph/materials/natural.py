@@ -31,13 +31,10 @@ calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for un
 
 from __future__ import annotations
 
-import csv
-import io
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass, field
-from importlib import resources
-from typing import Any, Literal, cast
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 import numpy as np
 
@@ -55,11 +52,15 @@ from rotomorph.materials.process import (
     actuation_fraction,
     dimensionless_rotation,
 )
+from rotomorph.materials.parameter_set import default_materials
 from rotomorph.materials.temperature import (
     active_modulus,
     passive_modulus,
     passive_strain_fraction,
 )
+
+if TYPE_CHECKING:
+    from rotomorph.materials.parameter_set import MaterialSet
 
 logger = logging.getLogger(__name__)
 
@@ -68,27 +69,25 @@ logger = logging.getLogger(__name__)
 DIRECTOR_HELIX_SENSE = -1.0
 
 
-def _calibrated_values() -> dict[str, float]:
-    """The default model's parameters (``data/model/calibrated_model.csv``, with their source)."""
-    text = resources.files("rotomorph.materials").joinpath("data/model/calibrated_model.csv")
-    rows = csv.DictReader(io.StringIO(text.read_text("utf-8")))
-    return {row["parameter"]: float(row["value"]) for row in rows}
-
+#: Field values of the default model: the paper's pair in the default materials file.
+_PAPER = default_materials().model_values("lce", "acrylate")
 
 #: Parameters of the default :class:`FilamentModel`: the chosen branch of the joint calibration
 #: on the paper's filament measurements (:func:`rotomorph.materials.calibrate.paper_calibration`),
-#: stored so that ``simulate``, ``paper``, the examples and the lattice use one model. A test
-#: keeps the stored values equal to a fresh calibration.
-CALIBRATED = _calibrated_values()
+#: stored in the default materials file (``data/paper_inks.toml``) so that ``simulate``,
+#: ``paper``, the examples and the lattice use one model. A test keeps the stored values equal
+#: to a fresh calibration.
+CALIBRATED = {
+    "modulus_ratio": _PAPER["modulus_ratio"],
+    "strain_model.gain": _PAPER["strain_model"].gain,
+    "strain_model.threshold": _PAPER["strain_model"].threshold,
+    "passive_strain": _PAPER["passive_strain"],
+}
 CALIBRATED_MODULUS_RATIO = CALIBRATED["modulus_ratio"]
 
 
 def _calibrated_strain_model() -> ActuationStrainModel:
-    return EmpiricalThreshold(
-        gain=CALIBRATED["strain_model.gain"],
-        threshold=CALIBRATED["strain_model.threshold"],
-        measure="hencky",
-    )
+    return _PAPER["strain_model"]  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True)
@@ -125,16 +124,32 @@ class FilamentModel:
         calibration works at full actuation, where both agree (free shapes at 175 °C to
         1e-4); they differ on the way (e.g. where a contracting lattice first touches
         itself).
+    director_pitch
+        Director helix per nozzle rotation: tan φ(R) = ``director_pitch`` · ω* at the surface
+        (dimensionless; 1 is the kinematic helix of the material lines).
+    print_temperature, actuation_temperature
+        Temperatures (°C) of the stored values: moduli measured at the first, full-actuation
+        values (strain law, modulus ratio, passive strain) reached at the second.
+    materials
+        The materials file whose inks the model looks names up in (:meth:`material`); ``None``:
+        the registry (:func:`~rotomorph.materials.material.get_material`, the paper's inks).
+        :meth:`MaterialSet.filament_model
+        <rotomorph.materials.parameter_set.MaterialSet.filament_model>` builds the model of a
+        set's ink pair.
     """
 
     strain_model: ActuationStrainModel = field(default_factory=_calibrated_strain_model)
     modulus_ratio: float | None = CALIBRATED_MODULUS_RATIO
     passive_strain: float | None = CALIBRATED["passive_strain"]
-    transition_width: float = 10.0
-    hysteresis: float = 0.0
+    transition_width: float = _PAPER["transition_width"]
+    hysteresis: float = _PAPER["hysteresis"]
     direction: Literal["heating", "cooling"] = "heating"
     resolution: int = DEFAULT_RESOLUTION
     temperature_dependent: bool = True
+    director_pitch: float = _PAPER["director_pitch"]
+    print_temperature: float = _PAPER["print_temperature"]
+    actuation_temperature: float = _PAPER["actuation_temperature"]
+    materials: MaterialSet | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.strain_model, ActuationStrainModel):
@@ -149,6 +164,25 @@ class FilamentModel:
             )
         if self.passive_strain is not None and not np.isfinite(self.passive_strain):
             raise InvalidParameterError("FilamentModel.passive_strain", "must be finite or None")
+        if not (np.isfinite(self.director_pitch) and self.director_pitch > 0.0):
+            raise InvalidParameterError(
+                "FilamentModel.director_pitch", f"must be > 0; got {self.director_pitch}"
+            )
+        if not (
+            np.isfinite(self.print_temperature)
+            and np.isfinite(self.actuation_temperature)
+            and self.print_temperature < self.actuation_temperature
+        ):
+            raise InvalidParameterError(
+                "FilamentModel.actuation_temperature",
+                "must be finite and above print_temperature (°C)",
+            )
+
+    def material(self, name: str) -> Material:
+        """The ink ``name`` from the model's materials file, else from the registry."""
+        if self.materials is not None:
+            return self.materials.material(name)
+        return get_material(name)
 
     def fraction(self, active: Material, temperature: float) -> float:
         """Actuation fraction x(T) ∈ [0, 1] of ``active`` at ``temperature`` (°C)."""
@@ -177,7 +211,7 @@ class FilamentModel:
             return active.youngs_modulus, e_p
         if temperature is None or not self.temperature_dependent:
             return self.modulus_ratio * e_p, e_p
-        e_p = passive_modulus(e_p, temperature)
+        e_p = passive_modulus(e_p, temperature, self.print_temperature)
         x = self.fraction(active, temperature)
         return active_modulus(active.youngs_modulus, self.modulus_ratio * e_p, x), e_p
 
@@ -191,7 +225,11 @@ class FilamentModel:
         """
         e_par, e_perp, eps_p = self.strains(speed, passive)
         x = self.fraction(active, temperature)
-        share = passive_strain_fraction(temperature) if self.temperature_dependent else x
+        share = (
+            passive_strain_fraction(temperature, self.print_temperature, self.actuation_temperature)
+            if self.temperature_dependent
+            else x
+        )
         return x * np.asarray(e_par), x * np.asarray(e_perp), share * eps_p
 
     def section(
@@ -231,32 +269,38 @@ class FilamentModel:
 MODEL_NAMES = ("calibrated", "warner-terentjev", "room-temperature")
 
 
-def named_model(name: str) -> FilamentModel:
-    """A filament model by name.
+def named_model(name: str, base: FilamentModel | None = None) -> FilamentModel:
+    """A filament model by name, built on ``base`` (default :class:`FilamentModel`, the paper's
+    calibrated model; a lab's: :meth:`MaterialSet.filament_model
+    <rotomorph.materials.parameter_set.MaterialSet.filament_model>`).
 
     ``calibrated``
-        The default (:data:`CALIBRATED`): joint fit to the paper's filament measurements.
+        ``base`` itself: for the default, the joint fit to the paper's filament measurements
+        (:data:`CALIBRATED`).
     ``warner-terentjev``
         Ideal-nematic-rubber strains with Q = S(v) (Warner & Terentjev, *Liquid Crystal
-        Elastomers*, OUP 2007) and the calibrated modulus ratio: a physical prior that does
-        not capture the speed dependence of the Janus curvature.
+        Elastomers*, OUP 2007; the ink's measured order parameter) and the calibrated modulus
+        ratio: a physical prior that does not capture the speed dependence of the Janus
+        curvature.
     ``room-temperature``
-        Warner-Terentjev strains with the inks' measured 25 °C moduli (E_a/E_p = 52): known to
-        under-predict the Janus curvature 2-4×; shows what the measured moduli alone give.
+        Warner-Terentjev strains with the inks' measured moduli at the print temperature
+        (E_a/E_p = 52 for the paper's inks): known to under-predict the Janus curvature 2-4×;
+        shows what the measured moduli alone give.
 
     Raises
     ------
     InvalidParameterError
         Unknown name (the message lists the known ones).
     """
+    model = FilamentModel() if base is None else base
+    points = getattr(model.strain_model, "order_points", None)
+    wt = WarnerTerentjev() if points is None else WarnerTerentjev(order_points=points)
     if name == "calibrated":
-        return FilamentModel()
+        return model
     if name == "warner-terentjev":
-        return FilamentModel(strain_model=WarnerTerentjev(), passive_strain=None)
+        return replace(model, strain_model=wt, passive_strain=None)
     if name == "room-temperature":
-        return FilamentModel(
-            strain_model=WarnerTerentjev(), modulus_ratio=None, passive_strain=None
-        )
+        return replace(model, strain_model=wt, modulus_ratio=None, passive_strain=None)
     raise InvalidParameterError("model", f"must be one of {MODEL_NAMES}; got {name!r}")
 
 
@@ -371,8 +415,13 @@ def _program_arrays(
     return pts, speed, rot, alpha, radius, frac
 
 
-def _material(name: str, materials: Mapping[str, Material] | None, kind: str) -> Material:
-    mat = get_material(name) if materials is None or name not in materials else materials[name]
+def _material(
+    name: str, materials: Mapping[str, Material] | None, kind: str, model: FilamentModel
+) -> Material:
+    if materials is not None and name in materials:
+        mat = materials[name]
+    else:
+        mat = model.material(name)
     if mat.kind != kind:
         raise MaterialError(f"PrintProgram.{kind}_material", f"{name!r} is {mat.kind}, not {kind}")
     return mat
@@ -441,6 +490,7 @@ def _vertex_increments(
     else:
         n_v = np.asarray(vn, dtype=float)[1:-1]
     omega_v = DIRECTOR_HELIX_SENSE * dimensionless_rotation(rot[1:-1], speed[1:-1], radius)
+    omega_v = model.director_pitch * omega_v  # the director helix (kinematic: pitch 1)
     active, passive, temperature = state
     e_par, e_perp, eps_p = model.strains_at(speed[1:-1], active, passive, temperature)
     eps_straight, _, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
@@ -608,8 +658,8 @@ def actuation_increments(
     pts, speed, rot, alpha, radius, frac = _program_arrays(program)
     # the rotation that winds the director helix (ideal step flips wind none)
     rot = np.asarray(getattr(program, "director_rotation", rot), dtype=float).reshape(-1)
-    active = _material(program.active_material, materials, "active")
-    passive = _material(program.passive_material, materials, "passive")
+    active = _material(program.active_material, materials, "active", model)
+    passive = _material(program.passive_material, materials, "passive", model)
     x = model.fraction(active, temperature)
     edge_speed = 0.5 * (speed[:-1] + speed[1:])
     edge_rot = 0.5 * (rot[:-1] + rot[1:])
@@ -617,7 +667,9 @@ def actuation_increments(
     # section and free strains at this temperature (moduli and strains: temperature laws)
     section = model.section(active, passive, radius, frac, temperature)
     e_par, e_perp, eps_p = model.strains_at(edge_speed, active, passive, temperature)
-    eps_c, _, _ = section.natural_strains(omega_star, e_par, e_perp, eps_p)
+    eps_c, _, _ = section.natural_strains(
+        model.director_pitch * omega_star, e_par, e_perp, eps_p
+    )
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
     normals = geometry.rotate_about_tangent(d1, t, alpha)
@@ -662,7 +714,8 @@ def natural_field(
         ``interface_angle`` (N-1,) rad (from d1 toward d2 = t × d1), ``radius`` mm,
         ``active_fraction`` in (0, 1], ``active_material`` and ``passive_material`` names.
     materials
-        Name → :class:`Material` overrides; names not in it come from the registry.
+        Name → :class:`Material` overrides; names not in it come from the model's materials
+        file (``model.materials``), else from the registry.
     temperature
         Actuation temperature T (°C); the paper actuates at 150-175 °C (full actuation).
     model

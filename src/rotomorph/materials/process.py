@@ -151,6 +151,18 @@ def order_parameter(
     return np.clip(s[seg] + slope * (x - lv[seg]), 0.0, 0.99)
 
 
+def _check_points(name: str, points: tuple[tuple[float, float], ...]) -> None:
+    """Refuse order-parameter points that :func:`order_parameter` cannot interpolate."""
+    try:
+        pts = [(float(v), float(s)) for v, s in points]
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, "must be (speed mm/s, S) pairs") from None
+    if len(pts) < 2 or len({v for v, _ in pts}) != len(pts):
+        raise InvalidParameterError(name, "needs >= 2 points at distinct speeds")
+    if not all(np.isfinite(v) and v > 0 and np.isfinite(s) and 0 <= s < 1 for v, s in pts):
+        raise InvalidParameterError(name, "needs speeds > 0 mm/s and S in [0, 1)")
+
+
 def backbone_anisotropy(q: float | FloatArray) -> FloatArray:
     """Backbone anisotropy r = (1 + 2Q)/(1 - Q) of an ideal nematic network.
 
@@ -212,18 +224,22 @@ class WarnerTerentjev:
         Strain measure of the returned strains.
     order_scale
         Q / S (dimensionless, default 1: the assumption Q ≈ S of the theory page).
+    order_points
+        Measured (v in mm/s, S) pairs of the ink's order parameter (:func:`order_parameter`).
     """
 
     measure: Measure = "hencky"
     order_scale: float = 1.0
+    order_points: tuple[tuple[float, float], ...] = PAPER_ORDER_POINTS
 
     def __post_init__(self) -> None:
         _check_measure(self.measure)
         _positive("WarnerTerentjev.order_scale", self.order_scale, "")
+        _check_points("WarnerTerentjev.order_points", self.order_points)
 
     def active_strains(self, speed: float | FloatArray) -> tuple[FloatArray, FloatArray]:
         """(ε∥, ε⊥) (dimensionless) for print speed v (mm/s)."""
-        r = backbone_anisotropy(self.order_scale * order_parameter(speed))
+        r = backbone_anisotropy(self.order_scale * order_parameter(speed, self.order_points))
         return (
             stretch_to_strain(r ** (-1.0 / 3.0), self.measure),
             stretch_to_strain(r ** (1.0 / 6.0), self.measure),
@@ -249,20 +265,25 @@ class EmpiricalThreshold:
         Order parameter S0 below which the LCE does not contract (dimensionless).
     measure
         Strain measure.
+    order_points
+        Measured (v in mm/s, S) pairs of the ink's order parameter (:func:`order_parameter`).
     """
 
     gain: float = 2.1
     threshold: float = 0.127
     measure: Measure = "hencky"
+    order_points: tuple[tuple[float, float], ...] = PAPER_ORDER_POINTS
 
     def __post_init__(self) -> None:
         _check_measure(self.measure)
         _positive("EmpiricalThreshold.gain", self.gain, "")
         _as_array("EmpiricalThreshold.threshold", self.threshold)
+        _check_points("EmpiricalThreshold.order_points", self.order_points)
 
     def active_strains(self, speed: float | FloatArray) -> tuple[FloatArray, FloatArray]:
         """(ε∥, ε⊥) (dimensionless) for print speed v (mm/s)."""
-        eps_par = -self.gain * np.maximum(order_parameter(speed) - self.threshold, 0.0)
+        s = order_parameter(speed, self.order_points)
+        eps_par = -self.gain * np.maximum(s - self.threshold, 0.0)
         if self.measure == "hencky":
             return eps_par, -0.5 * eps_par
         return eps_par, (1.0 + eps_par) ** -0.5 - 1.0

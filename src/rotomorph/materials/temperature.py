@@ -1,7 +1,8 @@
 r"""Moduli and free strains of the two inks between 25 °C and the actuation temperature.
 
-What is measured and what is assumed is stated, with sources, in
-``data/model/temperature_laws.csv`` (:func:`temperature_laws`). In short, with T in °C,
+What is measured and what is assumed is stated, with sources, by :func:`temperature_laws`
+(from the default materials file, ``data/paper_inks.toml``, which names the law of each ink:
+``modulus_law``, ``strain_law``). In short, with T in °C,
 T_K = T + 273.15, x(T) the nematic-isotropic fraction of
 :func:`rotomorph.materials.process.actuation_fraction` and m the effective modulus ratio at
 actuation:
@@ -20,12 +21,9 @@ Only the ratio E_a/E_p shapes a free filament; it runs from 52 (25 °C, measured
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from importlib import resources
 
 from rotomorph.errors import InvalidParameterError
 
@@ -45,9 +43,34 @@ ACTUATION_TEMPERATURE = 175.0
 _KELVIN = 273.15
 
 
+#: The temperature laws a materials file can name, in words (T in °C, x(T) the actuation
+#: fraction, subscript 0 the print temperature, 1 the actuation temperature).
+LAWS = {
+    "entropic": (
+        "E(T) = E(T0) (T + 273.15)/(T0 + 273.15)",
+        "entropic rubber elasticity above T_g: modulus proportional to absolute temperature; "
+        "Treloar, The Physics of Rubber Elasticity, 3rd ed., OUP 1975, ch. 4",
+    ),
+    "nematic-isotropic": (
+        "ln E_a(T) = (1 - x(T)) ln E_a(T0) + x(T) ln(m E_p(T))",
+        "log-linear between the measured cold and the calibrated hot value, following the "
+        "nematic-isotropic fraction x(T); a modelling choice, no measurement in between",
+    ),
+    "logistic": (
+        "eps(T) = x(T) eps_full; x(T) = 1/(1 + exp(-(T - T_NI)/w))",
+        "logistic stand-in for the normalized length vs temperature through T_NI",
+    ),
+    "linear": (
+        "eps_p(T) = eps_p (T - T0)/(T1 - T0)",
+        "linear thermal expansion from the print temperature (eps_p at the actuation "
+        "temperature T1)",
+    ),
+}
+
+
 @dataclass(frozen=True)
 class TemperatureLaw:
-    """One row of ``temperature_laws.csv``: a quantity, its law, status and source."""
+    """One quantity's law, value (or ``None``), unit, status and source."""
 
     quantity: str
     law: str
@@ -59,19 +82,39 @@ class TemperatureLaw:
 
 @lru_cache(maxsize=1)
 def temperature_laws() -> tuple[TemperatureLaw, ...]:
-    """The temperature laws with their status (measured / calibrated / assumed) and source."""
-    text = resources.files("rotomorph.materials").joinpath("data/model/temperature_laws.csv")
-    rows = csv.DictReader(io.StringIO(text.read_text("utf-8")))
-    return tuple(
+    """The temperature laws of the default inks with their status (cited / calibrated /
+    assumed) and source, read from the default materials file."""
+    from rotomorph.materials.parameter_set import default_materials
+
+    paper = default_materials()
+    lce, acr = paper.ink("lce"), paper.ink("acrylate")
+    ratio = getattr(lce, "actuated_modulus_ratio")  # noqa: B009 - the active ink's field
+    t_ni = getattr(lce, "transition_temperature")  # noqa: B009
+    t_act = paper.document.conditions.actuation_temperature
+    e_p, e_a = acr.youngs_modulus, lce.youngs_modulus
+
+    def law(quantity: str, name: str, unit: str, extra: str = "") -> TemperatureLaw:
+        text, why = LAWS[name]
+        return TemperatureLaw(quantity, text, None, unit, "assumed", why + extra)
+
+    return (
+        TemperatureLaw("passive_modulus_25C", "value", e_p.value, "MPa", e_p.provenance, e_p.source),
+        law("passive_modulus", acr.modulus_law, "MPa"),
+        TemperatureLaw("active_modulus_25C", "value", e_a.value, "MPa", e_a.provenance, e_a.source),
         TemperatureLaw(
-            r["quantity"],
-            r["law"],
-            float(r["value"]) if r["value"] else None,
-            r["unit"],
-            r["status"],
-            r["source"],
-        )
-        for r in rows
+            "active_modulus_hot",
+            "E_a(T) = m E_p(T) at full actuation",
+            ratio.value,
+            "1",
+            ratio.provenance,
+            f"m = the effective E_a/E_p: {ratio.source}",
+        ),
+        law("active_modulus", lce.modulus_law, "MPa"),
+        law("active_strain", "logistic", "1", f"; T_NI: {t_ni.source}"),
+        law("passive_strain", acr.strain_law, "1"),
+        TemperatureLaw(
+            "actuation_temperature", "value", t_act.value, "C", t_act.provenance, t_act.source
+        ),
     )
 
 
@@ -82,9 +125,12 @@ def _kelvin(temperature: float) -> float:
     return t + _KELVIN
 
 
-def passive_modulus(modulus_25: float, temperature: float) -> float:
-    """E_p(T) (MPa) of an entropic rubber measured at 25 °C (``modulus_25`` MPa)."""
-    return modulus_25 * _kelvin(temperature) / (PRINT_TEMPERATURE + _KELVIN)
+def passive_modulus(
+    modulus_25: float, temperature: float, reference: float = PRINT_TEMPERATURE
+) -> float:
+    """E_p(T) (MPa) of an entropic rubber measured at ``reference`` °C (``modulus_25`` MPa;
+    default 25 °C)."""
+    return modulus_25 * _kelvin(temperature) / _kelvin(reference)
 
 
 def active_modulus(modulus_25: float, hot_modulus: float, fraction: float) -> float:
@@ -103,7 +149,12 @@ def active_modulus(modulus_25: float, hot_modulus: float, fraction: float) -> fl
     return math.exp((1.0 - x) * math.log(modulus_25) + x * math.log(hot_modulus))
 
 
-def passive_strain_fraction(temperature: float) -> float:
-    """(T - 25)/(175 - 25): share of the 175 °C passive strain reached at T (thermal expansion)."""
+def passive_strain_fraction(
+    temperature: float,
+    start: float = PRINT_TEMPERATURE,
+    end: float = ACTUATION_TEMPERATURE,
+) -> float:
+    """(T - T_print)/(T_act - T_print), default (T - 25)/(175 - 25): share of the passive
+    strain at the actuation temperature reached at T (linear thermal expansion)."""
     _kelvin(temperature)
-    return (float(temperature) - PRINT_TEMPERATURE) / (ACTUATION_TEMPERATURE - PRINT_TEMPERATURE)
+    return (float(temperature) - start) / (end - start)
