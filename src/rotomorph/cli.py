@@ -250,11 +250,12 @@ def _print(text: str) -> None:
 # ----------------------------------------------------------------------------- commands
 
 
-def _check_materials(programs: list[Any]) -> None:
-    """Every material a program names must be known (raises MaterialError naming it)."""
+def _check_materials(programs: list[Any], materials: Any = None) -> None:
+    """Every material a program names must be known (raises MaterialError naming it): an ink
+    of the design's materials file, or a registered material."""
     from rotomorph.io.gcode import check_materials
 
-    check_materials(programs)
+    check_materials(programs, materials)
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
@@ -266,13 +267,15 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             return EXIT_OK
     if args.design is None:
         raise UsageError("validate: give DESIGN.toml (or --schema)")
+    if _is_materials_file(args.design):
+        return _validate_materials(args.design)
     # the same path as simulate and gcode: load_design (schema, ranges, size), then programs
     from rotomorph.io.gcode import gcode_text
     from rotomorph.io.placement import check_placement
 
     design = _load_design(args.design)
     programs = design.to_programs()
-    _check_materials(programs)
+    _check_materials(programs, design.material_set)
     machine_note = f"; fits machine {args.machine or 'built-in default'}"
     try:
         check_placement(design, _machine(args, note=False))  # names the design key to change
@@ -291,7 +294,41 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     _print(
         f"{args.design}: valid design '{design.name}': {', '.join(parts)}; "
         f"{len(programs)} print program(s), {length:.1f} mm of filament, "
-        f"{design_size(design).nodes} rod nodes; sha256 {design.sha256()[:12]}" + machine_note
+        f"{design_size(design).nodes} rod nodes; sha256 {design.sha256()[:12]}"
+        + _materials_note(design.material_set)
+        + machine_note
+    )
+    return EXIT_OK
+
+
+def _is_materials_file(path: str) -> bool:
+    """Whether ``path`` holds a materials file (``[inks]``, no filaments or lattice)."""
+    from rotomorph.errors import InvalidDesignError
+    from rotomorph.io.tomlfile import read_toml
+
+    try:
+        data = read_toml(_existing_file(path, "DESIGN"), InvalidDesignError)
+    except (InvalidDesignError, OSError):
+        return False  # load_design says why
+    return "inks" in data and "filaments" not in data and "lattice" not in data
+
+
+def _materials_note(materials: Any) -> str:
+    if materials is None:
+        return ""
+    inks = ", ".join(materials.names())
+    return f"; materials '{materials.name}' ({inks}; sha256 {materials.sha256[:12]})"
+
+
+def _validate_materials(path: str) -> int:
+    from rotomorph.io.materials_file import load_materials
+
+    inks = load_materials(path)
+    kinds = ", ".join(f"{n} ({inks.material(n).kind})" for n in inks.names())
+    assumed = sorted({f"{r.owner}.{r.key}" for r in inks.values() if r.provenance == "assumed"})
+    _print(
+        f"{path}: valid materials file '{inks.name}' version {inks.version}: {kinds}; "
+        f"{len(assumed)} assumed value(s); sha256 {inks.sha256[:12]}"
     )
     return EXIT_OK
 
@@ -362,7 +399,7 @@ def _cmd_gcode(args: argparse.Namespace) -> int:
         )
     machine = _machine(args)
     programs = design.to_programs()
-    _check_materials(programs)
+    _check_materials(programs, design.material_set)
     options = design.gcode_options()
     check_placement(design, machine)  # a refusal that names filaments[i].start / lattice.origin
     write_gcode(programs, out, machine, **options, layer_cure_s=args.cure)

@@ -53,7 +53,6 @@ from rotomorph.lattice.actuation import (
     get_actuation,
 )
 from rotomorph.lattice.model import lattice_model
-from rotomorph.materials.material import get_material
 from rotomorph.materials.natural import (
     DIRECTOR_HELIX_SENSE,
     FilamentModel,
@@ -94,13 +93,13 @@ class _Chain:
     def strains(self, speed: FloatArray) -> FloatArray:
         """Free LCE strains ``(n, 2)`` (ε∥, ε⊥) at full actuation for speeds ``(n,)``."""
         u = np.asarray(speed, dtype=float)
-        e_par, e_perp, _ = self.model.strains(u, get_material(self.lattice.passive_material))
+        e_par, e_perp, _ = self.model.strains(u, self.model.material(self.lattice.passive_material))
         return np.stack([np.broadcast_to(e_par, u.shape), np.broadcast_to(e_perp, u.shape)], 1)
 
     @property
     def passive_strain(self) -> float:
         """Free strain ε_p of the passive ink at full actuation (dimensionless)."""
-        return float(self.model.strains(1.0, get_material(self.lattice.passive_material))[2])
+        return float(self.model.strains(1.0, self.model.material(self.lattice.passive_material))[2])
 
     def strain_rates(self, speed: FloatArray) -> FloatArray:
         """d(strains)/d(speed) ``(n, 2)`` (s/mm), central differences (module docstring)."""
@@ -110,7 +109,7 @@ class _Chain:
 
     def _materials(self) -> tuple[Any, Any]:
         lat = self.lattice
-        return get_material(lat.active_material), get_material(lat.passive_material)
+        return self.model.material(lat.active_material), self.model.material(lat.passive_material)
 
     def strains_at(self, speed: FloatArray) -> FloatArray:
         """Free strains ``(n, 3)`` (ε∥, ε⊥, ε_p) reached at the actuation temperature."""

@@ -215,6 +215,8 @@ def design_filament(
     table: ResponseTable | None = None,
     tolerance: float = 0.02,
     verify: bool = True,
+    active_material: str = "lce",
+    passive_material: str = "acrylate",
 ) -> FilamentDesign:
     """Design the print program of one free filament that heats into ``target``.
 
@@ -242,6 +244,8 @@ def design_filament(
         Relative mismatch in curvature and twist above which a vertex is unreachable.
     verify
         Run the forward simulation and measure the achieved shape (default True).
+    active_material, passive_material
+        The inks (names of ``model``'s materials file, or registered ones).
 
     Raises
     ------
@@ -267,6 +271,8 @@ def design_filament(
             radius=radius,
             temperature=temperature,
             model=model,
+            active_material=active_material,
+            passive_material=passive_material,
         )
     kmax = table.curvature_range[1]
     if np.max(np.abs(geo.curvature)) > 3.0 * kmax:
@@ -309,7 +315,14 @@ def design_filament(
             f"length (rotation limit {max_rotation:g} rad/s at up to {speed_range[1]:g} mm/s)"
         )
     printed = np.stack([s_p, np.zeros_like(s_p), np.zeros_like(s_p)], axis=1)
-    program = PrintProgram.from_interface_angle(printed, speed, alpha, radius=radius)
+    program = PrintProgram.from_interface_angle(
+        printed,
+        speed,
+        alpha,
+        radius=radius,
+        active_material=active_material,
+        passive_material=passive_material,
+    )
     if not reachable.all():
         notes.append(f"{int((~reachable).sum())} of {len(reachable)} vertices are not reachable")
     achieved = pts.copy()

@@ -12,6 +12,7 @@ import csv
 import io
 import json
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,7 @@ from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
+from rotomorph.lattice.actuation import ProgramActuation
 from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
 
 __all__ = [
@@ -89,7 +91,26 @@ def _groups(values: FloatArray, tol: FloatArray) -> list[tuple[int, int]]:
     return out
 
 
-def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Design:
+def _inks_entry(target: TargetFile | None) -> dict[str, Any]:
+    """The design file's materials entry (the target's materials file, as an absolute path
+    that :func:`write_inverse` makes relative to the design) and ink names."""
+    if target is None or target.material_set is None:
+        return {}
+    return {"materials": str(Path(target.material_set.source).resolve())}
+
+
+def _ink_names(target: TargetFile | None) -> dict[str, str]:
+    if target is None or target.material_set is None:
+        return {}
+    return {
+        "active_material": target.options.active_material,
+        "passive_material": target.options.passive_material,
+    }
+
+
+def filament_design_file(
+    design: FilamentDesign, name: str = "inverse", target: TargetFile | None = None
+) -> Design:
     """The design file of a designed filament: line segments of constant speed and rotation.
 
     Each segment carries the speed of its moves and the rotation number that turns the nozzle
@@ -129,15 +150,20 @@ def filament_design_file(design: FilamentDesign, name: str = "inverse") -> Desig
                 "active_fraction": float(prog.active_fraction),
                 "initial_nozzle_angle_deg": math.degrees(float(prog.nozzle_angle[0])),
                 "segments": segments,
+                **_ink_names(target),
             }
         ],
+        **_inks_entry(target),
     }
     data.update(nozzle_table(float(prog.radius)))  # when the default nozzle cannot print it
-    return parse_design(data)
+    return parse_design(data, materials=None if target is None else target.material_set)
 
 
 def lattice_design_file(
-    design: LatticeDesign, name: str = "inverse", contact: ContactModel | None = None
+    design: LatticeDesign,
+    name: str = "inverse",
+    contact: ContactModel | None = None,
+    target: TargetFile | None = None,
 ) -> Design:
     """The design file of a designed lattice (``pattern = "custom"`` with per-edge modes and,
     where the design chose them, per-edge speeds), with the ``[contact]`` table it was designed
@@ -157,6 +183,7 @@ def lattice_design_file(
             "speed": lat.speed,
             # printed away from the machine's origin, as the example lattices are
             "origin": [20.0, 20.0, 0.0],
+            **_ink_names(target),
             **(
                 {}
                 if lat.edge_speeds is None
@@ -164,8 +191,9 @@ def lattice_design_file(
             ),
         },
         **({} if contact is None else {"contact": contact.model_dump()}),
+        **_inks_entry(target),
     }
-    return parse_design(data)
+    return parse_design(data, materials=None if target is None else target.material_set)
 
 
 def run_inverse(
@@ -177,12 +205,15 @@ def run_inverse(
     if target.kind == "curve":
         assert target.curve is not None
         speeds = (opt.min_speed, opt.max_speed)
+        fm = target.filament_model()
         table = cached_response_table(
             speed_range=speeds,
             max_omega_star=min(opt.radius * opt.max_rotation / opt.min_speed, 2.5),
             radius=opt.radius,
             temperature=opt.temperature,
-            model=None,
+            model=fm,
+            active_material=opt.active_material,
+            passive_material=opt.passive_material,
         )
         fil = design_filament(
             curve_points(target.curve),
@@ -192,6 +223,9 @@ def run_inverse(
             speed_range=speeds,
             max_rotation=opt.max_rotation,
             table=table,
+            model=target.filament_model(),
+            active_material=opt.active_material,
+            passive_material=opt.passive_material,
         )
         simple = simplest_program(
             fil,
@@ -201,7 +235,10 @@ def run_inverse(
             max_rotation=opt.max_rotation,
             spacing=opt.spacing,
             temperature=opt.temperature,
+            model=fm,
             name=name,
+            inks={**_inks_entry(target), "filament": _ink_names(target)},
+            materials=target.material_set,
         )
         runs = simple.settings
         notes = list(fil.notes)
@@ -247,6 +284,8 @@ def run_inverse(
         spec.amplitude,
         spec.ghost_nodes,
         pattern="dome" if target.kind != "saddle" else "saddle",
+        active_material=opt.active_material,
+        passive_material=opt.passive_material,
     )
     log: list[tuple[int, float]] = []
 
@@ -256,13 +295,15 @@ def run_inverse(
             progress(it, value)
 
     surf = target.surface_target()
-    env = lattice_surroundings(target.contact, lat, opt.temperature)
+    env = lattice_surroundings(target.contact, lat, opt.temperature, materials=target.material_set)
     env.pop("friction", None)  # 0: the target file refuses friction
     env.pop("branch", None)  # 'continuous' wherever it matters: the target file refuses the probe
     env.pop("path_check", None)  # 1: the target file refuses a path check
+    fm = target.filament_model()
     des = design_lattice(
         lat,
         surf,
+        actuation=None if fm is None else ProgramActuation(filament_model=fm),
         max_iterations=opt.max_iterations,
         speed_range=(opt.min_speed, opt.max_speed),
         speed_resolution=opt.speed_resolution,
@@ -289,7 +330,7 @@ def run_inverse(
         "speed_range_mm_s": [float(des.speeds.min()), float(des.speeds.max())],
         "contact": surroundings_record(target.contact, opt.temperature),
     }
-    design_file = lattice_design_file(des, name, target.contact)
+    design_file = lattice_design_file(des, name, target.contact, target)
     return InverseRun(target, design_file, summary, log, des)
 
 
@@ -322,7 +363,12 @@ def write_inverse(run: InverseRun, design_path: str | Path) -> list[Path]:
 
     design_path = Path(design_path)
     design_path.parent.mkdir(parents=True, exist_ok=True)
-    out = [save_design(run.design, design_path)]
+    design = run.design
+    if isinstance(design.materials, str):  # the materials file, relative to the design file
+        data = design.model_dump(mode="python")
+        data["materials"] = os.path.relpath(design.materials, design_path.parent.resolve())
+        design = parse_design(data, base=design_path.parent, materials=design.material_set)
+    out = [save_design(design, design_path)]
     folder = design_path.with_name(design_path.stem + "_inverse")
     folder.mkdir(parents=True, exist_ok=True)
     out.append(atomic_write_text(folder / "summary.json", json.dumps(run.summary, indent=2) + "\n"))

@@ -42,6 +42,7 @@ from rotomorph.inverse.response import ResponseTable
 from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import Design, parse_design
 from rotomorph.materials.natural import FilamentModel, natural_field
+from rotomorph.materials.parameter_set import MaterialSet
 from rotomorph.rod.model import Model
 
 __all__ = [
@@ -332,9 +333,17 @@ def _segments(
 
 
 def _design_file(
-    segments: list[Segment], spacing: float, radius: float, fraction: float, name: str
+    segments: list[Segment],
+    spacing: float,
+    radius: float,
+    fraction: float,
+    name: str,
+    inks: dict[str, Any] | None = None,
+    materials: MaterialSet | None = None,
 ) -> Design:
     text = "; ".join(s.text() for s in segments if not s.flip)
+    inks = dict(inks or {})
+    names = inks.pop("filament", {})
     return parse_design(
         {
             "schema_version": 1,
@@ -352,6 +361,7 @@ def _design_file(
                     "spacing": spacing,
                     "radius": radius,
                     "active_fraction": fraction,
+                    **names,
                     "segments": [
                         {
                             "kind": "line",
@@ -364,7 +374,9 @@ def _design_file(
                 }
             ],
             **nozzle_table(radius),  # when the default 1 mm nozzle cannot print the filament
-        }
+            **inks,
+        },
+        materials=materials if inks else None,
     )
 
 
@@ -392,6 +404,8 @@ def simplest_program(
     temperature: float = 175.0,
     model: FilamentModel | None = None,
     name: str = "inverse",
+    inks: dict[str, Any] | None = None,
+    materials: MaterialSet | None = None,
 ) -> SimpleProgram:
     """The fewest-segment printable design within ``tolerance`` (module docstring).
 
@@ -415,6 +429,10 @@ def simplest_program(
         Materials model (default: the calibrated one).
     name
         Name of the design and its filament.
+    inks, materials
+        The design file's materials entry and ink names (``{"materials": path, "filament":
+        {"active_material": …, "passive_material": …}}``) and the materials set they name;
+        ``None``: the paper's inks.
     """
     from rotomorph.simulate.free_shape import free_equilibrium
     from rotomorph.solve.static import solve_static
@@ -445,7 +463,7 @@ def simplest_program(
         segs, maps = _segments(
             runs, design, table, s, (need_k, need_t, weight), speed_range, max_rotation, radius
         )
-        file = _design_file(segs, spacing, radius, fraction, name)
+        file = _design_file(segs, spacing, radius, fraction, name, inks, materials)
         prog = file.to_programs()[0]
         nat = natural_field(prog, temperature=temperature, model=model)
         shape = free_equilibrium(Model.from_field(prog.points, nat))

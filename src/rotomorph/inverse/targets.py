@@ -28,12 +28,16 @@ An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``,
 ``bath``, ``branch``; frictionless only, no ``path_check``; with ``floor`` and ``gravity`` the
 branch must be ``"continuous"``) makes every equilibrium of a lattice design, and its adjoint,
 touch and rest as ``rotomorph simulate`` will; it is copied into the resulting design file.
+A lab's own inks: ``materials = "inks.toml"`` (a materials file, relative to the target file)
+and ``active_material``/``passive_material`` in ``[options]``; the design is then made with
+that file's model, and the resulting design file names the same materials file.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 from typing import Annotated, Any, Final, Literal
 
 import numpy as np
@@ -42,16 +46,21 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
+    PrivateAttr,
     ValidationError,
     model_validator,
 )
 
 from rotomorph._typing import FloatArray
-from rotomorph.errors import InvalidDesignError
+from rotomorph.errors import InvalidDesignError, MaterialError
 from rotomorph.inverse.lattice import SurfaceTarget, dome, height_map, saddle
 from rotomorph.io.design_limits import LIMITS
 from rotomorph.io.designfile import ContactModel, Label, as_vector3, schema_error
+from rotomorph.io.materials_file import resolve_materials
 from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
+from rotomorph.materials.material import get_material
+from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.parameter_set import MaterialSet
 
 __all__ = [
     "BYTES_PER_NODE",
@@ -203,6 +212,8 @@ class Options(_Model):
     max_iterations: int = Field(30, ge=1, le=500)
     radius: float = _limited("filament_radius", 0.3)
     tolerance: float = Field(0.005, gt=0, le=0.2, allow_inf_nan=False)
+    active_material: Label = Field("lce", min_length=1, max_length=100)
+    passive_material: Label = Field("acrylate", min_length=1, max_length=100)
 
 
 class TargetFile(_Model):
@@ -217,6 +228,22 @@ class TargetFile(_Model):
     lattice: LatticeSpec | None = None
     contact: ContactModel | None = None
     options: Options = Options()
+    materials: Label | None = Field(
+        None, description="materials file of the inks, relative to the target"
+    )
+    _material_set: MaterialSet | None = PrivateAttr(default=None)
+
+    @property
+    def material_set(self) -> MaterialSet | None:
+        """The materials file the target names (``None``: the paper's inks)."""
+        return self._material_set
+
+    def filament_model(self) -> FilamentModel | None:
+        """The model of the target's ink pair (``None``: the package default)."""
+        inks = self._material_set
+        if inks is None:
+            return None
+        return inks.filament_model(self.options.active_material, self.options.passive_material)
 
     @model_validator(mode="after")
     def _tables(self) -> TargetFile:
@@ -344,8 +371,9 @@ def _format(err: Any) -> tuple[str, str]:
     return loc, msg
 
 
-def parse_target(data: dict[str, Any]) -> TargetFile:
-    """Validate a mapping (parsed TOML) into a :class:`TargetFile`."""
+def parse_target(data: dict[str, Any], folder: str | Path | None = None) -> TargetFile:
+    """Validate a mapping (parsed TOML) into a :class:`TargetFile` (a ``materials`` path is
+    relative to ``folder``, the target file's; default the current folder)."""
     if "schema_version" not in data:
         raise InvalidDesignError("schema_version", "is required; add schema_version = 1")
     if "kind" not in data and ("filaments" in data or "lattice" in data):
@@ -356,10 +384,32 @@ def parse_target(data: dict[str, Any]) -> TargetFile:
             "(examples/targets/)",
         )
     try:
-        return TargetFile.model_validate(data)
+        target = TargetFile.model_validate(data)
     except ValidationError as exc:
         field, msg = _format(exc.errors()[0])
         raise InvalidDesignError(field, msg) from None
+    names = (target.options.active_material, target.options.passive_material)
+    if target.materials is None:
+        inks = None
+        lookup = get_material
+    else:
+        try:
+            inks = resolve_materials(target.materials, folder)
+        except MaterialError as err:
+            raise InvalidDesignError(err.field, str(err).partition(": ")[2]) from None
+        lookup = inks.material
+    for role, name in zip(("active", "passive"), names, strict=True):
+        try:
+            kind = lookup(name).kind
+        except MaterialError as err:
+            message = str(err).partition(": ")[2]
+            raise InvalidDesignError(f"options.{role}_material", message) from None
+        if kind != role:
+            raise InvalidDesignError(
+                f"options.{role}_material", f"{name!r} is a {kind} ink; give a {role} one"
+            )
+    target._material_set = inks
+    return target
 
 
 def parse_target_bytes(data: bytes, name: str = "<target>") -> TargetFile:
@@ -380,4 +430,4 @@ def load_target(path: str) -> TargetFile:
         data = read_toml(path, InvalidDesignError)
     except OSError as exc:
         raise InvalidDesignError(str(path), f"cannot be read: {exc.strerror}") from None
-    return parse_target(data)
+    return parse_target(data, Path(path).parent)

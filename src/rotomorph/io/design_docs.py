@@ -58,6 +58,8 @@ def _type(prop: dict[str, Any]) -> str:
                 names.append("array of [x, y, z]")
             else:
                 names.append(f"array of {items.get('type', 'values')}")
+        elif p.get("type") == "object":
+            names.append("inline table")
         else:
             names.append(str(p.get("type", "value")))
     optional = len(options) < len(prop.get("anyOf", [prop]))

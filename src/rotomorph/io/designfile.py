@@ -59,8 +59,11 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
+    PrivateAttr,
     ValidationError,
+    ValidationInfo,
     field_validator,
+    model_serializer,
     model_validator,
 )
 
@@ -90,8 +93,10 @@ from rotomorph.io.design_limits import (
     sinusoid_length,
 )
 from rotomorph.io.gcode import Process
+from rotomorph.io.materials_file import resolve_materials
 from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
 from rotomorph.materials.material import get_material, known_materials
+from rotomorph.materials.parameter_set import MaterialSet
 
 if TYPE_CHECKING:
     from pydantic_core import ErrorDetails
@@ -171,13 +176,17 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
-def _check_material(name: str, kind: str) -> str:
-    """``name`` if it is a registered material of ``kind`` ("active" or "passive")."""
+def _check_material(name: str, kind: str, info: ValidationInfo | None = None) -> str:
+    """``name`` if it is a material of ``kind`` ("active" or "passive"): an ink of the design's
+    materials file (validation context ``materials``) or, without one, a registered material."""
+    inks = (info.context or {}).get("materials") if info is not None else None
     try:
-        mat = get_material(name)
+        mat = get_material(name) if inks is None else inks.material(name)
     except MaterialError:
+        known = known_materials() if inks is None else inks.names()
+        where = "" if inks is None else f" in materials {inks.name!r}"
         raise ValueError(
-            f"unknown material {name!r}; use one of {', '.join(known_materials())}"
+            f"unknown material {name!r}{where}; use one of {', '.join(known)}"
         ) from None
     if mat.kind != kind:
         raise ValueError(f"{name!r} is {_article(mat.kind)} material; give {_article(kind)} one")
@@ -192,13 +201,17 @@ def _article(word: str) -> str:
 ActiveMaterial = Annotated[
     str,
     Field(min_length=1, max_length=100),
-    AfterValidator(lambda name: _check_material(name, "active")),
+    AfterValidator(lambda name, info: _check_material(name, "active", info)),
 ]
 PassiveMaterial = Annotated[
     str,
     Field(min_length=1, max_length=100),
-    AfterValidator(lambda name: _check_material(name, "passive")),
+    AfterValidator(lambda name, info: _check_material(name, "passive", info)),
 ]
+
+
+_ACTIVE: Final = "active ink: a name in the design's materials file (default: the paper's inks)"
+_PASSIVE: Final = "passive ink: a name in the design's materials file (default: the paper's inks)"
 
 
 class _Control(_Model):
@@ -318,8 +331,8 @@ class Filament(_Control, _Process):
     spacing: float = _ranged("vertex_spacing", 0.1, "rod vertex spacing")
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: ActiveMaterial = Field("lce", description="registered active material")
-    passive_material: PassiveMaterial = Field("acrylate", description="registered passive material")
+    active_material: ActiveMaterial = Field("lce", description=_ACTIVE)
+    passive_material: PassiveMaterial = Field("acrylate", description=_PASSIVE)
     layer: int = _ranged("layer", 0, "printed layer")
     segments: list[SegmentModel] = Field(
         min_length=1, max_length=MAX_NODES, description="the path, segment by segment"
@@ -531,8 +544,8 @@ class LatticeModel(_Process):
     )
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: ActiveMaterial = Field("lce", description="registered active material")
-    passive_material: PassiveMaterial = Field("acrylate", description="registered passive material")
+    active_material: ActiveMaterial = Field("lce", description=_ACTIVE)
+    passive_material: PassiveMaterial = Field("acrylate", description=_PASSIVE)
     origin: Vec3 = Field(
         (20.0, 20.0, 0.0),
         description="where the lattice's first branch node is printed (mm); the default keeps "
@@ -693,6 +706,25 @@ class Design(_Model):
     contact: ContactModel | None = Field(
         None, description="contact, floor and buoyant weight when heated (absent: none)"
     )
+    materials: str | dict[str, Any] | None = Field(
+        None,
+        description="materials file of the inks (TOML, path relative to the design; or an "
+        "inline table); absent: the paper's inks",
+    )
+    _material_set: MaterialSet | None = PrivateAttr(default=None)
+
+    @model_serializer(mode="wrap")
+    def _without_default_materials(self, handler: Any) -> Any:
+        """Designs without a materials file dump (and hash) as before the key existed."""
+        data = handler(self)
+        if isinstance(data, dict) and data.get("materials") is None:
+            data.pop("materials", None)
+        return data
+
+    @property
+    def material_set(self) -> MaterialSet | None:
+        """The materials file the design names (``None``: the paper's inks, the registry)."""
+        return self._material_set
 
     @field_validator("schema_version", mode="before")
     @classmethod
@@ -771,7 +803,8 @@ class Design(_Model):
         return [name for _, name in named]
 
     def gcode_options(self) -> dict[str, Any]:
-        """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (process, hash).
+        """Keyword arguments for :func:`rotomorph.io.gcode.write_gcode` (process, hash, and
+        the materials file when the design names one).
 
         One :class:`~rotomorph.io.gcode.Process` per program of :meth:`to_programs`, in the
         same order: each filament's or the lattice's pressures and dwells, else the nozzle's
@@ -783,11 +816,21 @@ class Design(_Model):
             owners += [(lattice, p) for p in lattice.to_lattice().print_programs()]
         owners.sort(key=lambda pair: pair[1].layer)  # stable, as to_programs
         process = [owner.process(self.nozzle, prog) for owner, prog in owners]
-        return {"process": process, "design_hash": self.sha256()}
+        options: dict[str, Any] = {"process": process, "design_hash": self.sha256()}
+        if self._material_set is not None:  # its inks, and its name and hash in the header
+            options["materials"] = self._material_set
+        return options
 
     def sha256(self) -> str:
-        """sha256 (hex) of the canonical JSON of the design."""
-        blob = json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+        """sha256 (hex) of the canonical JSON of the design (with the content hash of its
+        materials file, so that a changed ink changes the design's hash)."""
+        data = self.model_dump(mode="json")
+        if self._material_set is not None:
+            data["materials"] = {
+                "entry": data.get("materials"),
+                "sha256": self._material_set.sha256,
+            }
+        blob = json.dumps(data, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -853,14 +896,37 @@ def schema_error(err: ErrorDetails) -> tuple[str, str]:
     return field, msg
 
 
-def parse_design(data: dict[str, Any]) -> Design:
-    """Validate a mapping (a parsed TOML document) into a :class:`Design`."""
+def parse_design(
+    data: dict[str, Any],
+    *,
+    base: str | FilePath | None = None,
+    materials: MaterialSet | None = None,
+) -> Design:
+    """Validate a mapping (a parsed TOML document) into a :class:`Design`.
+
+    Parameters
+    ----------
+    data
+        The design's keys.
+    base
+        Folder a ``materials`` path is relative to (the design file's; default the current one).
+    materials
+        The design's materials set, already read (skips reading ``materials`` again).
+    """
     if "schema_version" not in data:
         raise InvalidDesignError(
             "schema_version", f"is required; add schema_version = {SCHEMA_VERSION}"
         )
+    entry = data.get("materials") if isinstance(data, dict) else None
+    if entry is None:
+        materials = None  # no materials file named: the paper's inks (the registry)
+    elif materials is None and isinstance(entry, str | dict):
+        try:
+            materials = resolve_materials(entry, base)
+        except MaterialError as err:
+            raise InvalidDesignError(err.field, str(err).partition(": ")[2]) from None
     try:
-        return Design.model_validate(data)
+        design = Design.model_validate(data, context={"materials": materials})
     except ValidationError as exc:
         errors = _same_fault_once([schema_error(e) for e in exc.errors()])
         field, msg = errors[0]
@@ -868,6 +934,8 @@ def parse_design(data: dict[str, Any]) -> Design:
             "" if len(errors) == 1 else "; also " + "; ".join(f"{f}: {m}" for f, m in errors[1:4])
         )
         raise InvalidDesignError(field, msg + more) from None
+    design._material_set = materials
+    return design
 
 
 def _same_fault_once(errors: list[tuple[str, str]]) -> list[tuple[str, str]]:
@@ -897,12 +965,15 @@ def load_design(path: str | FilePath) -> Design:
     OSError
         The file cannot be read.
     """
-    return parse_design(read_toml(path, InvalidDesignError))
+    return parse_design(read_toml(path, InvalidDesignError), base=FilePath(path).parent)
 
 
-def parse_design_bytes(data: bytes, name: str = "<design>") -> Design:
-    """Validate the bytes of a TOML design file (as :func:`load_design`, without a file)."""
-    return parse_design(decode_toml_bytes(data, name, InvalidDesignError))
+def parse_design_bytes(
+    data: bytes, name: str = "<design>", *, base: str | FilePath | None = None
+) -> Design:
+    """Validate the bytes of a TOML design file (as :func:`load_design`, without a file; a
+    ``materials`` path is relative to ``base``, default the current folder)."""
+    return parse_design(decode_toml_bytes(data, name, InvalidDesignError), base=base)
 
 
 def design_size(design: Design) -> SizeEstimate:
@@ -924,7 +995,7 @@ def with_spacing(design: Design, spacing: float) -> Design:
     data = design.model_dump(mode="python")
     for fil in data["filaments"]:
         fil["spacing"] = spacing
-    return parse_design(data)
+    return parse_design(data, materials=design.material_set)
 
 
 def save_design(design: Design, path: str | FilePath) -> FilePath:

@@ -57,6 +57,7 @@ from rotomorph.io.design_limits import MAX_LAYER_CURE_S
 from rotomorph.io.machine import MachineProfile, check_line, fill_template
 from rotomorph.io.print_order import machine_order
 from rotomorph.materials.material import get_material, known_materials
+from rotomorph.materials.parameter_set import MaterialSet
 
 __all__ = [
     "MAX_LINE",
@@ -213,10 +214,11 @@ def programs_sha256(programs: Sequence[PrintProgram]) -> str:
     return hashlib.sha256(blob).hexdigest()
 
 
-def check_materials(programs: Sequence[PrintProgram]) -> None:
-    """Every material a program names must be registered and be one printable word.
+def check_materials(programs: Sequence[PrintProgram], materials: MaterialSet | None = None) -> None:
+    """Every material a program names must be known and be one printable word.
 
-    The same check as ``rotomorph validate`` (``get_material``), plus the text check of
+    The same check as ``rotomorph validate``: an ink of ``materials`` (the design's materials
+    file) or, without one, a registered material (``get_material``); plus the text check of
     everything written into a program, so a name can neither be unknown nor inject a line.
 
     Raises
@@ -231,12 +233,18 @@ def check_materials(programs: Sequence[PrintProgram]) -> None:
             name = getattr(program, f"{role}_material")
             check_line(f"print program {i}: {role} material", name, token=True)
             try:
-                get_material(name)
+                mat = get_material(name) if materials is None else materials.material(name)
             except MaterialError:
+                known = known_materials() if materials is None else materials.names()
+                where = "" if materials is None else f" in materials {materials.name!r}"
                 raise MaterialError(
                     f"print program {i}: {role} material",
-                    f"unknown material {name!r}; known: {', '.join(known_materials())}",
+                    f"unknown material {name!r}{where}; known: {', '.join(known)}",
                 ) from None
+            if mat.kind != role:
+                raise MaterialError(
+                    f"print program {i}: {role} material", f"{name!r} is a {mat.kind} material"
+                )
 
 
 def pressure_lines(m: MachineProfile, port: int, psi: float, on: bool) -> list[str]:
@@ -448,6 +456,15 @@ def _travel_height(m: MachineProfile, top: float, *zs: float) -> float:
     return z
 
 
+def _materials_line(materials: MaterialSet | None) -> list[str]:
+    """The header line naming the materials file (its name, version and content hash)."""
+    if materials is None:
+        return []
+    line = f"; materials: {materials.name} version {materials.version} sha256 {materials.sha256}"
+    check_line("materials", line)
+    return [line]
+
+
 def _header(
     m: MachineProfile,
     n: int,
@@ -553,6 +570,7 @@ def gcode_text(
     layer_cure_s: float = 0.0,
     design_hash: str | None = None,
     serpentine: bool = True,
+    materials: MaterialSet | None = None,
 ) -> str:
     """G-code for ``programs`` on ``machine`` (pure; see module docstring for the layout).
 
@@ -573,6 +591,9 @@ def gcode_text(
         sha256 to record in the header; default :func:`programs_sha256` of ``programs``.
     serpentine
         Print a program backward when that avoids a return travel (:func:`plan_programs`).
+    materials
+        The design's materials file: the programs' inks must be its inks, and the header
+        names it (name, version, sha256); ``None``: registered materials.
 
     Raises
     ------
@@ -597,7 +618,7 @@ def gcode_text(
         )
     if design_hash is not None and not re.fullmatch(r"[0-9a-f]{64}", design_hash):
         raise InvalidParameterError("design_hash", "must be a sha256 hex digest (64 characters)")
-    check_materials(programs)
+    check_materials(programs, materials)
     if process is None:
         process = Process(placeholders=PLACEHOLDER_SETTINGS)
     procs = _as_process(process, len(programs))
@@ -677,6 +698,7 @@ def gcode_text(
         w,
         placeholders,
     )
+    head = [*head[:3], *_materials_line(materials), *head[3:]]  # after the design's hash
     body = [*gcode_aerotech.declarations(m), *m.header_lines, *(m.setup_lines or ()), *w.lines]
     text = "\n".join([*head, *body]) + "\n"
     if re.search(r"[^\x20-\x7e\n]", text):  # pragma: no cover - every input is checked
@@ -759,6 +781,7 @@ def write_gcode(
     layer_cure_s: float = 0.0,
     design_hash: str | None = None,
     serpentine: bool = True,
+    materials: MaterialSet | None = None,
 ) -> FilePath:
     """Write :func:`gcode_text` to ``path`` atomically and return the path.
 
@@ -771,5 +794,6 @@ def write_gcode(
         layer_cure_s=layer_cure_s,
         design_hash=design_hash,
         serpentine=serpentine,
+        materials=materials,
     )
     return atomic_write_text(path, text)

@@ -50,7 +50,6 @@ from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
-from rotomorph.materials.material import get_material
 from rotomorph.materials.natural import (
     ActuationIncrements,
     FilamentModel,
@@ -202,12 +201,12 @@ def _janus_curvature(lm: LatticeModel, fm: FilamentModel) -> tuple[float, float]
             "with per-edge speeds needs actuation 'program'",
         )
     sec = fm.section(
-        get_material(lat.active_material),
-        get_material(lat.passive_material),
+        fm.material(lat.active_material),
+        fm.material(lat.passive_material),
         lat.radius,
         lat.active_fraction,
     )
-    e_par, e_perp, eps_p = fm.strains(lat.speeds[:1], get_material(lat.passive_material))
+    e_par, e_perp, eps_p = fm.strains(lat.speeds[:1], fm.material(lat.passive_material))
     eps_c, kappa, _ = sec.natural_strains(0.0, e_par, e_perp, eps_p)
     return float(kappa[0, 0]), float(np.asarray(eps_c).reshape(-1)[0])
 
@@ -287,7 +286,8 @@ class ThermalActuation:
 
     def fraction(self, lm: LatticeModel, temperature: float) -> float:
         """Actuation fraction x(T) ∈ [0, 1] (dimensionless)."""
-        return self._fm().fraction(get_material(lm.lattice.active_material), temperature)
+        fm = self._fm()
+        return fm.fraction(fm.material(lm.lattice.active_material), temperature)
 
     def natural(self, lm: LatticeModel, parameter: float) -> Model:
         """Printed curvature plus x(T) K_J toward the active side, rest lengths × exp(x ε_c)."""

@@ -146,8 +146,8 @@ def _stiffness(
             )
         fm = FilamentModel() if fm is None else fm
         sec = fm.section(
-            get_material(lattice.active_material),
-            get_material(lattice.passive_material),
+            fm.material(lattice.active_material),
+            fm.material(lattice.passive_material),
             r,
             lattice.active_fraction,
         )

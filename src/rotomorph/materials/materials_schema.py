@@ -111,15 +111,15 @@ def _convert(key: str, v: Value) -> Value:
     if dim == "temperature_difference":  # a width: K and °C differ by scale 1 only
         base = {"C": 1.0, "°C": 1.0, "degC": 1.0, "K": 1.0}
         if v.unit.strip() not in base:
-            raise ValueError(f"{key}.unit: {v.unit!r} is not a temperature difference; use 'C' or 'K'")
+            raise ValueError(
+                f"{key}.unit: {v.unit!r} is not a temperature difference; use 'C' or 'K'"
+            )
         return v.model_copy(update={"unit": "C"})
     try:
         value = to_canonical(dim, v.value, v.unit)
         sd = None if v.sd is None else spread_to_canonical(dim, v.sd, v.unit)
         interval = (
-            None
-            if v.interval is None
-            else [to_canonical(dim, x, v.unit) for x in v.interval]
+            None if v.interval is None else [to_canonical(dim, x, v.unit) for x in v.interval]
         )
     except InvalidParameterError as err:
         raise ValueError(f"{key}.unit: {str(err).split(': ', 1)[-1]}") from None
@@ -153,8 +153,8 @@ class Conditions(_Converting):
     def _order(self) -> Conditions:
         if not self.print_temperature.value < self.actuation_temperature.value:
             raise ValueError(
-                "actuation_temperature.value: must exceed print_temperature (°C): the values at full "
-                "actuation are those reached on heating from the print temperature"
+                "actuation_temperature.value: must exceed print_temperature (°C): the values "
+                "at full actuation are those reached on heating from the print temperature"
             )
         return self
 
@@ -169,9 +169,12 @@ class NozzleGeometry(_Converting):
     @model_validator(mode="after")
     def _ranges(self) -> NozzleGeometry:
         if not 0.01 <= self.filament_radius.value <= 10.0:
-            raise ValueError(f"filament_radius.value: must lie in [0.01, 10] mm; got {self.filament_radius.value}")
+            got = self.filament_radius.value
+            raise ValueError(f"filament_radius.value: must lie in [0.01, 10] mm; got {got}")
         if not 0.0 < self.active_fraction.value <= 1.0:
-            raise ValueError(f"active_fraction.value: must lie in (0, 1]; got {self.active_fraction.value}")
+            raise ValueError(
+                f"active_fraction.value: must lie in (0, 1]; got {self.active_fraction.value}"
+            )
         return self
 
 
@@ -186,13 +189,21 @@ class _Ink(_Converting):
     @model_validator(mode="after")
     def _physical(self) -> _Ink:
         if not self.youngs_modulus.value > 0:
-            raise ValueError(f"youngs_modulus.value: must be > 0 MPa; got {self.youngs_modulus.value}")
+            raise ValueError(
+                f"youngs_modulus.value: must be > 0 MPa; got {self.youngs_modulus.value}"
+            )
         if not -1.0 < self.poisson_ratio.value <= 0.5:
-            raise ValueError(f"poisson_ratio.value: must lie in (-1, 0.5]; got {self.poisson_ratio.value}")
+            raise ValueError(
+                f"poisson_ratio.value: must lie in (-1, 0.5]; got {self.poisson_ratio.value}"
+            )
         if not 0.01 <= self.density.value <= 30.0:
-            raise ValueError(f"density.value: must lie in [0.01, 30] g/cm3; got {self.density.value}")
+            raise ValueError(
+                f"density.value: must lie in [0.01, 30] g/cm3; got {self.density.value}"
+            )
         if self.free_length is not None and not 0.05 < self.free_length.value < 20.0:
-            raise ValueError(f"free_length.value: must lie in (0.05, 20) (L/L0); got {self.free_length.value}")
+            raise ValueError(
+                f"free_length.value: must lie in (0.05, 20) (L/L0); got {self.free_length.value}"
+            )
         if self.glass_transition is not None and self.glass_transition.value < -273.15:
             raise ValueError("glass_transition.value: must be >= -273.15 °C")
         return self
@@ -227,9 +238,13 @@ class ActiveInk(_Ink):
         other = {"strain_gain", "strain_threshold", "order_scale"} - set(need)
         extra = sorted(k for k in other if getattr(self, k) is not None)
         if extra:
-            raise ValueError(f"{extra[0]}: is not used by strain_law = '{self.strain_law}'; remove it")
+            raise ValueError(
+                f"{extra[0]}: is not used by strain_law = '{self.strain_law}'; remove it"
+            )
         if self.strain_gain is not None and not self.strain_gain.value > 0:
-            raise ValueError("strain_gain.value: must be > 0 (the LCE contracts along its director)")
+            raise ValueError(
+                "strain_gain.value: must be > 0 (the LCE contracts along its director)"
+            )
         if self.order_scale is not None and not self.order_scale.value > 0:
             raise ValueError("order_scale.value: must be > 0")
         if not self.actuated_modulus_ratio.value > 0:
@@ -273,7 +288,9 @@ class PassiveInk(_Ink):
     @model_validator(mode="after")
     def _strain(self) -> PassiveInk:
         if not -0.5 < self.free_strain.value < 0.5:
-            raise ValueError(f"free_strain.value: must lie in (-0.5, 0.5); got {self.free_strain.value}")
+            raise ValueError(
+                f"free_strain.value: must lie in (-0.5, 0.5); got {self.free_strain.value}"
+            )
         return self
 
 

@@ -45,14 +45,13 @@ from rotomorph.errors import InvalidDesignError, InvalidParameterError, Material
 from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection, filament_section
 from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.morphology import HelixShape, free_helix
+from rotomorph.materials.parameter_set import default_materials
 from rotomorph.materials.process import (
     ActuationStrainModel,
-    EmpiricalThreshold,
     WarnerTerentjev,
     actuation_fraction,
     dimensionless_rotation,
 )
-from rotomorph.materials.parameter_set import default_materials
 from rotomorph.materials.temperature import (
     active_modulus,
     passive_modulus,
@@ -667,9 +666,7 @@ def actuation_increments(
     # section and free strains at this temperature (moduli and strains: temperature laws)
     section = model.section(active, passive, radius, frac, temperature)
     e_par, e_perp, eps_p = model.strains_at(edge_speed, active, passive, temperature)
-    eps_c, _, _ = section.natural_strains(
-        model.director_pitch * omega_star, e_par, e_perp, eps_p
-    )
+    eps_c, _, _ = section.natural_strains(model.director_pitch * omega_star, e_par, e_perp, eps_p)
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
     normals = geometry.rotate_about_tangent(d1, t, alpha)

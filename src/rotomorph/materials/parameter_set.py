@@ -255,8 +255,12 @@ class MaterialSet:
                 add(name, key, getattr(ink, key))
             if isinstance(ink, ActiveInk):
                 c = ink.order_parameter
-                text = ", ".join(f"{s:g} at {v:g} mm/s" for v, s in zip(c.speed, c.value, strict=True))
-                rows.append(ValueRow(name, "order_parameter", text, "1", None, c.provenance, c.source))
+                text = ", ".join(
+                    f"{s:g} at {v:g} mm/s" for v, s in zip(c.speed, c.value, strict=True)
+                )
+                rows.append(
+                    ValueRow(name, "order_parameter", text, "1", None, c.provenance, c.source)
+                )
         return rows
 
 

@@ -98,7 +98,9 @@ def temperature_laws() -> tuple[TemperatureLaw, ...]:
         return TemperatureLaw(quantity, text, None, unit, "assumed", why + extra)
 
     return (
-        TemperatureLaw("passive_modulus_25C", "value", e_p.value, "MPa", e_p.provenance, e_p.source),
+        TemperatureLaw(
+            "passive_modulus_25C", "value", e_p.value, "MPa", e_p.provenance, e_p.source
+        ),
         law("passive_modulus", acr.modulus_law, "MPa"),
         TemperatureLaw("active_modulus_25C", "value", e_a.value, "MPa", e_a.provenance, e_a.source),
         TemperatureLaw(

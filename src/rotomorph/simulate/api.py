@@ -70,7 +70,8 @@ def predict(
     design: DesignLike | PrintProgram, *, temperature: float = 175.0, model: Any = None
 ) -> Any:
     """Closed-form shape of each filament at ``temperature`` (°C): the free helix of its
-    natural curvature and twist (instant; uniform filaments only).
+    natural curvature and twist (instant; uniform filaments only), with the inks of the
+    design's materials file when it names one.
 
     Returns
     -------
@@ -85,8 +86,9 @@ def predict(
     """
     from rotomorph.materials.natural import FilamentModel, named_model, natural_field
 
-    if isinstance(model, str):  # a name, as simulate accepts
-        model = named_model(model)
+    name = model if isinstance(model, str) else None  # a name, as simulate accepts
+    if name is not None:
+        model = named_model(name)  # fails early on an unknown name
     if model is not None and not isinstance(model, FilamentModel):
         from rotomorph.errors import InvalidParameterError
 
@@ -98,7 +100,18 @@ def predict(
         from rotomorph.errors import InvalidDesignError
 
         raise InvalidDesignError("lattice", "has no closed-form shape; use rotomorph.simulate")
-    return [natural_field(p, None, temperature, model=model).morphology() for p in d.to_programs()]
+    from rotomorph.simulate.inks import design_model
+
+    # each filament with its ink pair's model (the design's materials file, if it names one)
+    return [
+        natural_field(
+            p,
+            None,
+            temperature,
+            model=design_model(d, p.active_material, p.passive_material, name or model),
+        ).morphology()
+        for p in d.to_programs()
+    ]
 
 
 def write_gcode(

@@ -34,6 +34,7 @@ from rotomorph.simulate.filament import (
     FilamentSimulation,
     simulate_filament,
 )
+from rotomorph.simulate.inks import design_model, materials_record
 from rotomorph.simulate.options import TEMPERATURE_ACTUATIONS, check_run_options
 from rotomorph.simulate.surroundings import (
     filament_surroundings,
@@ -184,7 +185,7 @@ def _simulate_filaments(
     steps: int,
     start_temperature: float,
     temperature: float,
-    model: FilamentModel | None,
+    model: FilamentModel | str | None,
     progress: Progress | None,
 ) -> DesignSimulation:
     sims = []
@@ -197,7 +198,8 @@ def _simulate_filaments(
             steps,
         )
         program = fil.to_program()
-        contact, loads = filament_surroundings(design.contact, program, fil)
+        fil_model = design_model(design, fil.active_material, fil.passive_material, model)
+        contact, loads = filament_surroundings(design.contact, program, fil, design.material_set)
         sims.append(
             simulate_filament(
                 program,
@@ -205,7 +207,7 @@ def _simulate_filaments(
                 steps=steps,
                 start_temperature=start_temperature,
                 temperature=temperature,
-                model=model,
+                model=fil_model,
                 progress=progress,
                 contact=contact,
                 loads=loads,
@@ -348,7 +350,7 @@ def _simulate_lattice(
     progress: Progress | None,
     start_temperature: float | None = None,
     temperature: float | None = None,
-    model: FilamentModel | None = None,
+    model: FilamentModel | str | None = None,
 ) -> DesignSimulation:
     from rotomorph.lattice.heating import heat_lattice  # lattice-only
 
@@ -365,6 +367,7 @@ def _simulate_lattice(
         steps,
     )
     lattice = lat.to_lattice()
+    model = design_model(design, lat.active_material, lat.passive_material, model)
     rule = _lattice_actuation(actuation, start_temperature, temperature, model)
     hot = float(getattr(rule, "end", ACTUATION_TEMPERATURE))  # x-readings: the paper's 175 °C
     in_temperature = actuation in ("thermal", "program")  # else the ramp is an abstract x
@@ -377,6 +380,7 @@ def _simulate_lattice(
             lattice,
             hot,
             ramp_in_temperature=in_temperature,
+            materials=design.material_set,
         ),
     )
     if progress is not None:
@@ -485,15 +489,13 @@ def simulate_design(
         raise InvalidDesignError(
             "lattice", "simulate handles filaments or a lattice, not both; split the design file"
         )
-    if isinstance(model, str):  # a name, as on the command line (--model)
-        model = named_model(model)
-    check_run_options(
+    check_run_options(  # a model name is resolved per ink pair (design_model)
         "lattice" if design.lattice is not None else "filaments",
         steps=steps,
         start_temperature=start_temperature,
         temperature=temperature,
         spacing=spacing,
-        model=model,
+        model=named_model(model) if isinstance(model, str) else model,
         actuation=actuation,
     )
     if design.lattice is not None:
@@ -522,6 +524,7 @@ def simulate_design(
         rotomorph_version=rotomorph.__version__,
         design_name=design.name,
         design_sha256=design.sha256(),
+        materials=materials_record(design),
         wall_time_s=round(time.perf_counter() - t0, 3),
     )
     return replace(sim, metadata=meta)

@@ -38,7 +38,7 @@ from rotomorph.analysis.shape import (
 )
 from rotomorph.contact import Contact
 from rotomorph.errors import InvalidParameterError, RotomorphError
-from rotomorph.materials.material import Material, get_material
+from rotomorph.materials.material import Material
 from rotomorph.materials.natural import FilamentModel, NaturalField, natural_field
 from rotomorph.materials.process import actuation_fraction
 from rotomorph.rod.model import Model
@@ -159,9 +159,11 @@ class FilamentSimulation:
         return plot_run(describe_run(self.to_run()), folder, movie=movie)
 
 
-def _active_material(program: Any, materials: Mapping[str, Material] | None) -> Material:
+def _active_material(
+    program: Any, materials: Mapping[str, Material] | None, model: FilamentModel
+) -> Material:
     name = program.active_material
-    return materials[name] if materials and name in materials else get_material(name)
+    return materials[name] if materials and name in materials else model.material(name)
 
 
 def heating_temperatures(
@@ -196,7 +198,7 @@ def heating_temperatures(
             f"must exceed the start temperature {start_temperature} °C; got {temperature} °C",
         )
     model = FilamentModel() if model is None else model
-    active = _active_material(program, materials)
+    active = _active_material(program, materials, model)
     grid = np.linspace(start_temperature, temperature, 2001)
     x = actuation_fraction(
         grid,

@@ -20,20 +20,25 @@ import numpy as np
 from rotomorph.contact import Contact, Floor
 from rotomorph.materials.bath import bath_density, bath_fluids
 from rotomorph.materials.material import get_material
+from rotomorph.materials.parameter_set import MaterialSet
 from rotomorph.solve.loads import Gravity, Loads
 
 __all__ = ["filament_surroundings", "lattice_surroundings", "surroundings_record"]
 
 
-def _density(active: str, passive: str, active_fraction: float) -> float:
-    """Section density (g/cm³): the inks' densities by area share (1.1 where none is given)."""
-    rho_a = get_material(active).density or 1.1
-    rho_p = get_material(passive).density or 1.1
+def _density(
+    active: str, passive: str, active_fraction: float, materials: MaterialSet | None = None
+) -> float:
+    """Section density (g/cm³): the inks' densities by area share (1.1 where none is given),
+    the inks of ``materials`` (the design's materials file) or registered ones."""
+    find = get_material if materials is None else materials.material
+    rho_a = find(active).density or 1.1
+    rho_p = find(passive).density or 1.1
     return float(active_fraction * rho_a + (1.0 - active_fraction) * rho_p)
 
 
 def filament_surroundings(
-    contact: Any, program: Any, filament: Any
+    contact: Any, program: Any, filament: Any, materials: MaterialSet | None = None
 ) -> tuple[Contact | None, Callable[[float], Loads] | None]:
     """Contact settings of one filament and its loads as a function of the bath temperature
     (°C) (``None, None`` without ``[contact]``; loads ``None`` without gravity).
@@ -46,6 +51,8 @@ def filament_surroundings(
         The filament's print program (vertices, radius).
     filament
         The filament's design entry (materials, active fraction).
+    materials
+        The design's materials file (``None``: registered materials).
     """
     if contact is None:
         return None, None
@@ -60,7 +67,7 @@ def filament_surroundings(
     if not contact.gravity:
         return settings, None
     density = _density(
-        filament.active_material, filament.passive_material, filament.active_fraction
+        filament.active_material, filament.passive_material, filament.active_fraction, materials
     )
     area, bath = np.pi * radius**2, str(contact.bath)
 
@@ -72,11 +79,17 @@ def filament_surroundings(
 
 
 def lattice_surroundings(
-    contact: Any, lattice: Any, temperature: float, *, ramp_in_temperature: bool = False
+    contact: Any,
+    lattice: Any,
+    temperature: float,
+    *,
+    ramp_in_temperature: bool = False,
+    materials: MaterialSet | None = None,
 ) -> dict[str, Any]:
     """Keyword arguments of :func:`rotomorph.lattice.heating.heat_lattice` for ``[contact]``
     (empty without it): ``contact``, ``floor``, ``gravity``, ``friction``, ``branch``,
-    ``path_check``. The buoyant weight is that in the bath at ``temperature`` (°C), or, with
+    ``path_check``. The buoyant weight (the inks of ``materials``, the design's materials
+    file, or registered ones) is that in the bath at ``temperature`` (°C), or, with
     ``ramp_in_temperature`` (a ramp whose parameter is the temperature), at every ramp
     temperature (:func:`rotomorph.lattice.heating.lattice_buoyancy`)."""
     if contact is None:
@@ -91,7 +104,10 @@ def lattice_surroundings(
         "path_check": int(contact.path_check),
     }
     if contact.gravity:
-        weight = lattice_buoyancy(lattice, bath=contact.bath)
+        density = None  # registered inks: the lattice layer's own look-up
+        if materials is not None:  # the lattice's two inks, as lattice_gravity averages them
+            density = _density(lattice.active_material, lattice.passive_material, 0.5, materials)
+        weight = lattice_buoyancy(lattice, bath=contact.bath, density=density)
         kwargs["gravity"] = weight if ramp_in_temperature else weight(temperature)
     return kwargs
 

@@ -169,15 +169,17 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
     if spec.machine is not None:
         _check_machine(design, spec.machine)
     s = spec.settings
-    model = filament_model(s["filament_model"])
+    model = _sweep_model(design, s["filament_model"])
     if s["method"] == "closed_form":
         from rotomorph.materials.natural import natural_field
+        from rotomorph.simulate.inks import design_model
 
         shapes = []
         for fil in design.filaments:
             if s["spacing"] is not None:
                 fil = fil.model_copy(update={"spacing": s["spacing"]})
-            field = natural_field(fil.to_program(), None, s["temperature"], model=model)
+            pair = design_model(design, fil.active_material, fil.passive_material, model)
+            field = natural_field(fil.to_program(), None, s["temperature"], model=pair)
             shapes.append(closed_form_metrics(field.morphology()))
         physical = {"verdict": "unknown", "reason": "closed form: no equilibrium was solved"}
         return {"filaments": shapes, "physical": physical}, None
@@ -216,6 +218,25 @@ def _compute(spec: RunSpec) -> tuple[dict[str, Any], RunResults | None]:
     verdict = meta.get("physical") or {}
     metrics["physical"] = {"verdict": verdict.get("verdict"), "reason": verdict.get("reason")}
     return metrics, described if spec.hdf5 else None
+
+
+def _sweep_model(design: Any, name: str) -> Any:
+    """The model a sweep's ``filament_model`` names for ``design``: a name of
+    :data:`~rotomorph.materials.natural.MODEL_NAMES` is resolved per ink pair of the design's
+    materials file (``simulate`` does so); the paper's leave-one-group-out models apply to the
+    paper's inks only."""
+    from rotomorph.materials.natural import MODEL_NAMES
+
+    if name in MODEL_NAMES:
+        return name if design.material_set is not None else filament_model(name)
+    if design.material_set is not None:
+        raise InvalidParameterError(
+            "settings.filament_model",
+            f"{name!r} is the paper's calibration without one of its groups, for the paper's "
+            "inks; a design with its own materials file takes one of "
+            f"{', '.join(MODEL_NAMES)}",
+        )
+    return filament_model(name)
 
 
 class _Collect(logging.Handler):

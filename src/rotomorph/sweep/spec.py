@@ -362,11 +362,16 @@ def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
         )
     data = dict(data)
     base = Path(folder)
+    design_folder = base
     if isinstance(data.get("design"), str):
         path = base / data["design"]
+        design_folder = path.parent
         if not path.is_file():
             raise InvalidParameterError("design", f"{path}: no such design file")
         data["design"] = read_toml(path, InvalidDesignError)  # UTF-8, size, syntax
+    design_data = data.get("design")
+    if isinstance(design_data, dict) and isinstance(design_data.get("materials"), str):
+        data["design"] = _inline_materials(design_data, design_folder)
     machine = data.get("machine")
     if isinstance(machine, dict) and "profile" in machine:
         rest = {k: v for k, v in machine.items() if k != "profile"}
@@ -398,6 +403,20 @@ def parse_sweep(data: dict[str, Any], *, folder: str | Path = ".") -> Sweep:
     sweep.machine_profile()
     check_outputs(sweep.outputs, design, sweep.settings.method)
     return sweep
+
+
+def _inline_materials(design: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``design`` with its materials file (a path relative to ``folder``) read in as an inline
+    table: every run then carries its inks, the run ids hash their content, and runs on other
+    machines (a Dask cluster) need no file."""
+    from rotomorph.errors import MaterialError
+    from rotomorph.io.materials_file import resolve_materials
+
+    try:
+        inks = resolve_materials(design["materials"], folder)
+    except MaterialError as err:
+        raise InvalidDesignError(f"design.{err.field}", str(err).partition(": ")[2]) from None
+    return {**design, "materials": inks.document.model_dump(mode="json", exclude_none=True)}
 
 
 def _profile_dict(profile: MachineProfile) -> dict[str, Any]:
