@@ -13,6 +13,7 @@ Commands::
     rotomorph inverse TARGET.toml -o DESIGN.toml   print program for a target shape
     rotomorph predict DESIGN.toml [--json]    closed-form shapes with the calibration band
     rotomorph predict --for curvature=0.4     print settings that give a wanted shape
+    rotomorph calibrate TABLES.csv… -o INKS.toml   a lab's own inks from its measurements
 
 Exit codes: 0 success; 1 the computation failed (solver did not converge);
 2 bad input (command line, design file, machine limits, missing file, existing output folder).
@@ -588,6 +589,47 @@ def _cmd_inverse(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from rotomorph.materials.lab_calibration import CalibrationSettings
+    from rotomorph.simulate.ink_calibration import calibrate_files
+
+    tables = [_existing_file(p, "MEASUREMENTS") for p in args.measurements]
+    out = Path(args.output)
+    if not args.output or out.suffix != ".toml":
+        raise UsageError("-o/--output: give the materials file to write, ending in .toml")
+    if out.exists() and not args.force:
+        raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
+    _check_writable(out, create_parent=True, inputs=tables)
+    folder = out.with_name(out.stem + "_calibration")
+    if any(t.resolve().is_relative_to(folder.resolve()) for t in tables):
+        raise UsageError(f"-o/--output: {folder} (the report folder) holds an input table")
+    name = args.name or "".join(c if c.isalnum() or c in "_.+-" else "-" for c in out.stem)
+    settings = CalibrationSettings(
+        name=name.strip("-_.+") or "lab-inks",
+        active=args.active,
+        passive=args.passive,
+        print_temperature=args.print_temperature,
+        actuation_temperature=args.actuation_temperature,
+        radius=args.radius,
+        active_fraction=args.active_fraction,
+    )
+    for flag, value in (
+        ("--print-temperature", args.print_temperature),
+        ("--actuation-temperature", args.actuation_temperature),
+    ):
+        if value is not None and not (math.isfinite(value) and -50.0 <= value <= 300.0):
+            raise UsageError(f"{flag}: must lie in [-50, 300] °C; got {value:g}")
+    if args.radius is not None and not (math.isfinite(args.radius) and 0.01 <= args.radius <= 10):
+        raise UsageError(f"--radius: must lie in [0.01, 10] mm; got {args.radius:g}")
+    if args.active_fraction is not None and not 0.0 < args.active_fraction <= 1.0:
+        raise UsageError(f"--active-fraction: must lie in (0, 1]; got {args.active_fraction:g}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with _phases():
+        run = calibrate_files(tables, out, settings, lattices=not args.no_lattices)
+    _print(run.summary_line())
+    return EXIT_OK
+
+
 # ----------------------------------------------------------------------------- parser
 
 
@@ -747,6 +789,31 @@ def build_parser() -> argparse.ArgumentParser:
     )
     predict.add_arguments(p)
     p.set_defaults(func=predict.command)
+
+    p = sub.add_parser(
+        "calibrate",
+        help="calibrate a lab's own inks from its measurement tables",
+        description="Fit the materials model to measurement tables (CSV: quantity, condition, "
+        "x, x_unit, value, spread, unit, source; docs/design-files.md) and write a materials "
+        "file (INKS.toml) that designs name with materials = 'INKS.toml', and a report in "
+        "INKS_calibration/ (identifiability, fits, leave-one-group-out predictions, figures).",
+    )
+    p.add_argument("measurements", nargs="+", metavar="MEASUREMENTS.csv")
+    p.add_argument("-o", "--output", required=True, metavar="INKS.toml")
+    p.add_argument("--name", help="name of the materials file (default: from INKS)")
+    p.add_argument("--active", metavar="NAME", help="active ink name (default: the tables')")
+    p.add_argument("--passive", metavar="NAME", help="passive ink name (default: the tables')")
+    p.add_argument("--print-temperature", type=float, metavar="C", help="default 25 °C (assumed)")
+    p.add_argument(
+        "--actuation-temperature", type=float, metavar="C", help="default 175 °C (assumed)"
+    )
+    p.add_argument("--radius", type=float, metavar="MM", help="filament radius, default 0.3 mm")
+    p.add_argument("--active-fraction", type=float, help="active share, default 0.5")
+    p.add_argument(
+        "--no-lattices", action="store_true", help="skip the lattice validation ramps (slow)"
+    )
+    p.add_argument("--force", action="store_true", help="replace an existing materials file")
+    p.set_defaults(func=_cmd_calibrate)
     return parser
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -54,8 +55,34 @@ def _inks() -> tuple[Material, Material]:
     return get_material("lce"), get_material("acrylate")
 
 
+def _state(
+    model: FilamentModel,
+    speed: FloatArray,
+    inks: tuple[Material, Material] | None,
+    radius: float,
+    fraction: float,
+    temperature: float | None,
+) -> tuple[Any, FloatArray, FloatArray, Any]:
+    """Section and free strains of the pair at full actuation (``temperature`` None, the
+    paper calibration) or at ``temperature`` (°C, as ``simulate`` evaluates them)."""
+    active, passive = _inks() if inks is None else inks
+    section = model.section(active, passive, radius, fraction, temperature)
+    v = np.asarray(speed, dtype=float)
+    if temperature is None:
+        e_par, e_perp, eps_p = model.strains(v, passive)
+    else:
+        e_par, e_perp, eps_p = model.strains_at(v, active, passive, temperature)
+    return section, e_par, e_perp, eps_p
+
+
 def janus_curvature(
-    model: FilamentModel, speed: FloatArray, radius: float = PAPER_RADIUS
+    model: FilamentModel,
+    speed: FloatArray,
+    radius: float = PAPER_RADIUS,
+    *,
+    inks: tuple[Material, Material] | None = None,
+    active_fraction: float = 0.5,
+    temperature: float | None = None,
 ) -> FloatArray:
     """Curvature K_J (1/mm, toward the active side) of a heated Janus filament at ω* = 0.
 
@@ -74,10 +101,14 @@ def janus_curvature(
         Print speeds v (mm/s).
     radius
         Filament radius R (mm).
+    inks
+        (active, passive) materials; default the paper's.
+    active_fraction
+        Active share of the section.
+    temperature
+        ``None``: full actuation (the paper calibration); else at that temperature (°C).
     """
-    active, passive = _inks()
-    section = model.section(active, passive, radius, 0.5)
-    e_par, e_perp, eps_p = model.strains(np.asarray(speed, dtype=float), passive)
+    section, e_par, e_perp, eps_p = _state(model, speed, inks, radius, active_fraction, temperature)
     eps_c, kappa, _ = section.natural_strains(0.0, e_par, e_perp, eps_p)
     return kappa[:, 0] / strain_to_stretch(eps_c, model.strain_model.measure)
 
@@ -86,8 +117,11 @@ def filament_shapes(
     model: FilamentModel,
     omega_star: FloatArray,
     active_fraction: float,
-    speed: float = ROTATION_SERIES_SPEED,
+    speed: float | FloatArray = ROTATION_SERIES_SPEED,
     radius: float = PAPER_RADIUS,
+    *,
+    inks: tuple[Material, Material] | None = None,
+    temperature: float | None = None,
 ) -> list[HelixShape]:
     """Closed-form free shapes of straight filaments printed at rotation rates ω*.
 
@@ -100,18 +134,21 @@ def filament_shapes(
     active_fraction
         0.5 (Janus composite) or 1.0 (pure LCE).
     speed
-        Print speed v (mm/s).
+        Print speed v (mm/s), one or one per ω*.
     radius
         Filament radius R (mm).
+    inks
+        (active, passive) materials; default the paper's.
+    temperature
+        ``None``: full actuation (the paper calibration); else at that temperature (°C).
     """
-    active, passive = _inks()
-    section = model.section(active, passive, radius, active_fraction)
     # the director helix turns with DIRECTOR_HELIX_SENSE * omega* in the filament frame (the
     # design layer's alpha = psi - alpha_n), so the helix has the handedness the rod solver gives
     # the same print program
     w = DIRECTOR_HELIX_SENSE * np.atleast_1d(np.asarray(omega_star, dtype=float))
-    e_par, e_perp, eps_p = model.strains(np.full(len(w), speed), passive)
-    eps_c, kappa, dtau = section.natural_strains(w, e_par, e_perp, eps_p)
+    v = np.broadcast_to(np.asarray(speed, dtype=float), w.shape)
+    section, e_par, e_perp, eps_p = _state(model, v, inks, radius, active_fraction, temperature)
+    eps_c, kappa, dtau = section.natural_strains(model.director_pitch * w, e_par, e_perp, eps_p)
     measure = model.strain_model.measure
     return [
         free_helix(float(np.hypot(*k)), float(wi / radius + dt), float(e), measure=measure)
