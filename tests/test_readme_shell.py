@@ -84,6 +84,8 @@ def test_readme_shell_commands_run_verbatim(tmp_path):
     assert (repo / "out" / "report.md").is_file() and (repo / "out" / "summary.json").is_file()
     assert (repo / "runs" / "composite" / "results.h5").is_file()
     assert (repo / "runs" / "composite" / "view.html").is_file()
+    assert (repo / "runs" / "inks.toml").is_file()
+    assert (repo / "runs" / "inks_calibration" / "calibration.md").is_file()
     html = repo / "docs" / "_build" / "html"
     assert (html / "index.html").is_file() and (html / "tutorial.html").is_file()
     assert any((html / "api" / "generated").glob("rotomorph.rod.model*.html"))

@@ -331,8 +331,10 @@ class Filament(_Control, _Process):
     spacing: float = _ranged("vertex_spacing", 0.1, "rod vertex spacing")
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: ActiveMaterial = Field("lce", description=_ACTIVE)
-    passive_material: PassiveMaterial = Field("acrylate", description=_PASSIVE)
+    active_material: ActiveMaterial = Field("lce", description=_ACTIVE, validate_default=True)
+    passive_material: PassiveMaterial = Field(
+        "acrylate", description=_PASSIVE, validate_default=True
+    )
     layer: int = _ranged("layer", 0, "printed layer")
     segments: list[SegmentModel] = Field(
         min_length=1, max_length=MAX_NODES, description="the path, segment by segment"
@@ -544,8 +546,10 @@ class LatticeModel(_Process):
     )
     radius: float = _ranged("filament_radius", 0.3, "filament radius R")
     active_fraction: float = Field(0.5, gt=0, le=1, description="active share of the section")
-    active_material: ActiveMaterial = Field("lce", description=_ACTIVE)
-    passive_material: PassiveMaterial = Field("acrylate", description=_PASSIVE)
+    active_material: ActiveMaterial = Field("lce", description=_ACTIVE, validate_default=True)
+    passive_material: PassiveMaterial = Field(
+        "acrylate", description=_PASSIVE, validate_default=True
+    )
     origin: Vec3 = Field(
         (20.0, 20.0, 0.0),
         description="where the lattice's first branch node is printed (mm); the default keeps "
@@ -920,7 +924,13 @@ def parse_design(
     entry = data.get("materials") if isinstance(data, dict) else None
     if entry is None:
         materials = None  # no materials file named: the paper's inks (the registry)
-    elif materials is None and isinstance(entry, str | dict):
+    elif not isinstance(entry, str | dict):
+        raise InvalidDesignError(
+            "materials",
+            "must be the path of a materials file in quotes (TOML, relative to the design) or "
+            f"an inline table; got {entry!r} ({type(entry).__name__})",
+        )
+    elif materials is None:
         try:
             materials = resolve_materials(entry, base)
         except MaterialError as err:

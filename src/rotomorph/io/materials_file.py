@@ -101,10 +101,11 @@ def resolve_materials(entry: Any, base: str | Path | None) -> MaterialSet:
     try:
         return load_materials(path)
     except MaterialError as err:
-        detail = str(err).partition(": ")[2]
-        inner = err.field.removeprefix(f"{path}: ").removeprefix(str(path))
-        inner = f" {inner}:" if inner and inner != str(path) else ""
-        raise MaterialError("materials", f"{shown}:{inner} {detail}") from None
+        detail = str(err)[len(err.field) + 2 :]
+        inner = err.field.removeprefix(str(path)).removeprefix(": ")
+        raise MaterialError(
+            "materials", f"{shown}: {inner + ': ' if inner else ''}{detail}"
+        ) from None
     except OSError as err:
         raise MaterialError("materials", f"{shown}: cannot be read ({err.strerror})") from None
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import PurePath
 from typing import Any, Final
 
 import numpy as np
@@ -114,6 +115,9 @@ class CalibrationSettings:
         Section-mesh resolution of the fit.
     leave_one_out
         Refit without each group and predict it (the out-of-sample check).
+    report
+        Where the calibration report is written (relative to the materials file), recorded in
+        the file.
     """
 
     name: str = "lab-inks"
@@ -125,6 +129,7 @@ class CalibrationSettings:
     active_fraction: float | None = None
     resolution: int = FIT_RESOLUTION
     leave_one_out: bool = True
+    report: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -160,9 +165,11 @@ def _weighted(rows: Sequence[Measurement]) -> tuple[float, float]:
 
 
 def _cite(rows: Sequence[Measurement]) -> str:
+    """``name.csv rows 3, 4 (source)``: the file's name (not its folder: the file written is
+    the same wherever the tables were read from; the data hash identifies them)."""
     files: dict[str, list[int]] = {}
     for m in rows:
-        files.setdefault(m.file, []).append(m.row)
+        files.setdefault(PurePath(m.file).name, []).append(m.row)
     parts = [
         f"{f} row{'s' if len(r) > 1 else ''} {', '.join(map(str, r))}" for f, r in files.items()
     ]
@@ -431,7 +438,7 @@ def calibrate_tables(
     fit = joint.chosen
     after = identifiability(
         groups, params, base, fit.theta, labels=LABELS, hints=HINTS,
-        where=f"the fitted optimum, branch {fit.label}",
+        where=f"the fitted optimum, branch {fit.label.replace('model.modulus_ratio', 'E_a/E_p')}",
     )  # fmt: skip
     held_out: dict[str, tuple[FloatArray, FloatArray]] = {}
     if settings.leave_one_out and len(groups) > 1:
@@ -593,12 +600,13 @@ def _materials_set(
         "calibration": {
             "method": "rotomorph calibrate: maximum a posteriori with Gaussian priors on both "
             "modulus-ratio branches, weights 1/sd^2, Laplace covariance, leave-one-group-out",
-            "tables": [f"{name} (sha256 {sha[:16]})" for name, sha in data.files],
+            "tables": [f"{PurePath(name).name} (sha256 {sha[:16]})" for name, sha in data.files],
             "data_sha256": data.sha256,
             "chosen_branch": fit.label.replace("model.modulus_ratio", "E_a/E_p"),
             "branch_choice": joint.choice.replace("model.modulus_ratio", "E_a/E_p"),
             "determined": [FILE_KEYS[n][1] for n in after.determined],
             "at_prior": [FILE_KEYS[n][1] for n in after.at_prior],
+            "report": settings.report,
         },
         "inks": {active_name: active, passive_name: passive},
     }

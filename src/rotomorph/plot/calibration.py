@@ -64,8 +64,9 @@ def fit_figure(
             capsize=3, label=m.label,
         )  # fmt: skip
     if held_out is not None and len(held_out.x):
-        span = np.ptp(np.concatenate([m.x for m in measured])) if measured else 1.0
-        shift = held_out.x * 1.04 if log_x else held_out.x + 0.02 * (span or 1.0)
+        xs = np.concatenate([*(m.x for m in measured), *(c.x for c in curves)])
+        span = float(np.ptp(xs)) if len(xs) else 1.0
+        shift = held_out.x * 1.04 if log_x else held_out.x + 0.015 * (span or 1.0)
         ax.errorbar(
             shift, held_out.y, yerr=held_out.sd, fmt="s", color="tab:red", ms=5, capsize=3,
             label=held_out.label,
@@ -137,5 +138,5 @@ def identifiability_figure(
     ax.set_xlim(0.0, 1.05)
     ax.set_xlabel("posterior width / prior width")
     ax.set_title("what the tables determine", fontsize=10)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=2, frameon=False)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
     return fig

@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -90,7 +90,7 @@ class CalibrationRun:
             f"wrote {self.materials_path} and {self.report_folder}/calibration.md: "
             f"{len(cal.measurements.rows)} rows of {len(cal.measurements.files)} table(s); "
             f"determined: {words(det)}; at their priors: {words(prior)}; branch "
-            f"{cal.fit.label.replace('model.', '')}"
+            f"{cal.fit.label.replace('model.modulus_ratio', 'E_a/E_p')}"
         )
 
 
@@ -120,8 +120,6 @@ def _sinusoid(m: Measurement, pair: InkPair, names: tuple[str, str], inks: Any) 
 
 
 def _sinusoid_ratio(program: Any, pair: InkPair, resolution: int) -> float:
-    from dataclasses import replace
-
     mats = {program.active_material: pair.active, program.passive_material: pair.passive}
     model = replace(pair.model, resolution=resolution)
     field_ = natural_field(program, mats, model.actuation_temperature, model=model)
@@ -332,6 +330,11 @@ def calibrate_files(
     """
     say = progress or (lambda text: logger.info("%s", text))
     out = Path(output)
+    folder = out.with_name(out.stem + "_calibration")
+    settings = replace(
+        CalibrationSettings() if settings is None else settings,
+        report=f"{folder.name}/calibration.md",
+    )
     say("reading the measurement tables")
     data = read_measurements(measurements)
     say("identifiability, then the joint fit on both branches and leave-one-group-out refits")
@@ -339,7 +342,6 @@ def calibrate_files(
     say("validation rows and the calibration bands")
     validation = predict_validation(cal, lattices=lattices)
     curves = _group_curves(cal)
-    folder = out.with_name(out.stem + "_calibration")
     written: list[Path] = []
     with atomic_folder(folder) as tmp:
         figs = _figures(cal, curves, tmp) if figures else []

@@ -28,6 +28,10 @@ def _cell(text: Any) -> str:
     return re.sub(r"([\\`*_\[\]<>|~&$])", r"\\\1", s)
 
 
+def _branch(text: str) -> str:
+    return text.replace("model.modulus_ratio", "E_a/E_p")
+
+
 def _num(x: float | None, sd: float | None = None) -> str:
     if x is None or not np.isfinite(x):
         return "—"
@@ -112,12 +116,13 @@ def report_markdown(
     ]
     for b in cal.joint.branches:
         vals = ", ".join(f"{k.split('.')[-1]} {v:.4g}" for k, v in b.values.items())
-        bound = f" (on a bound: {', '.join(b.at_bound)})" if b.at_bound else ""
+        bound = f" (on a bound: {_branch(', '.join(b.at_bound))})" if b.at_bound else ""
         lines.append(
-            f"| {_cell(b.label)}{_cell(bound)} | {b.chi2_data:.3f} | {b.chi2_prior:.3f} | "
+            f"| {_cell(_branch(b.label))}{_cell(bound)} | {b.chi2_data:.3f} | {b.chi2_prior:.3f} | "
             f"{_cell(vals)} |"
         )
-    lines += ["", f"Chosen: {_cell(fit.label)}. {_cell(cal.joint.choice)}", ""]
+    choice = _branch(cal.joint.choice)
+    lines += ["", f"Chosen: {_cell(_branch(fit.label))}. {_cell(choice)}", ""]
     lines += ["## Fitted values and their priors", ""]
     lines += [
         "| parameter | written as | value | ±1 sd | prior | width ratio | status |",

@@ -1,0 +1,101 @@
+"""``rotomorph calibrate``: tables in, a materials file, its report and figures out; the design
+that names the file prints; bad input exits 2 with one line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rotomorph.cli import main
+from rotomorph.io.materials_file import load_materials
+
+ROOT = Path(__file__).resolve().parents[2]
+INKS = ROOT / "examples" / "inks"
+TABLES = [str(INKS / n) for n in ("filaments.csv", "inks.csv", "sinusoids.csv")]
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("cal") / "lab" / "inks.toml"
+    assert main(["calibrate", *TABLES, "-o", str(out)]) == 0
+    return out
+
+
+def test_writes_the_file_report_and_figures(calibrated, capsys) -> None:
+    inks = load_materials(calibrated)
+    assert inks.names() == ("lce", "acrylate") and inks.name == "inks"
+    folder = calibrated.with_name("inks_calibration")
+    report = (folder / "calibration.md").read_text("utf-8")
+    for section in (
+        "## What the tables determine",
+        "## The two branches of the bilayer symmetry",
+        "## Fitted values and their priors",
+        "### janus_curvature",
+        "predicted without this table",
+        "## Validation only (never fitted)",
+        "## Where the model is measured (extrapolation ranges)",
+        "T\\_NI: stays at its prior",
+    ):
+        assert section in report, section
+    for name in ("janus_curvature", "pure_lce_length", "composite_length", "residuals"):
+        assert (folder / f"{name}.png").stat().st_size > 10_000
+    record = json.loads((folder / "calibration.json").read_text())
+    assert record["materials"]["sha256"] == inks.sha256
+    assert {v["quantity"] for v in record["validation"]} == {"sinusoid_end_to_end"}
+    assert all(v["predicted"] is not None for v in record["validation"])
+    # the committed example is this very calibration (a fresh run reproduces its values)
+    example = load_materials(INKS / "inks.toml")
+    fresh = {(r.owner, r.key): r for r in inks.values()}
+    stored = {(r.owner, r.key): r for r in example.values()}
+    assert fresh.keys() == stored.keys()
+    for key, r in stored.items():
+        assert r.provenance == fresh[key].provenance and r.unit == fresh[key].unit, key
+        if isinstance(r.value, float):
+            assert r.value == pytest.approx(fresh[key].value, rel=1e-6, abs=1e-12), key
+    assert example.document.calibration.data_sha256 == inks.document.calibration.data_sha256
+
+
+def test_a_design_naming_the_file_validates_and_prints(calibrated, tmp_path, capsys) -> None:
+    design = INKS / "lattice.toml"
+    assert main(["validate", str(design)]) == 0
+    assert "materials 'inks'" in capsys.readouterr().out
+    gcode = tmp_path / "lattice.gcode"
+    assert main(["gcode", str(design), "-o", str(gcode), "--dialect", "rs274"]) == 0
+    assert "; materials: inks version 1 sha256" in gcode.read_text("ascii")
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["calibrate", str(INKS / "inks.csv"), "-o", "x.json"], "ending in .toml"),
+        (["calibrate", "missing.csv", "-o", "x.toml"], "MEASUREMENTS: missing.csv: no such file"),
+        (["calibrate", str(INKS / "inks.csv"), "-o", "x.toml", "--radius", "0"], "--radius"),
+        (["calibrate", str(INKS / "inks.csv"), "-o", "x.toml"], "missing measurement"),
+        (
+            ["calibrate", *TABLES, "-o", "x.toml", "--active", "rm82"],
+            "--active: 'rm82' but the tables name the active ink 'lce'",
+        ),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, monkeypatch, args, fragment) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and fragment in err, err
+    assert not (tmp_path / "x.toml").exists()
+
+
+def test_bad_table_names_file_row_and_column(tmp_path, capsys) -> None:
+    bad = tmp_path / "bad.csv"
+    text = (INKS / "inks.csv").read_text("utf-8").replace(",2.55,MPa,", ",0,MPa,")
+    bad.write_text(text, encoding="utf-8")
+    assert main(["calibrate", str(bad), "-o", str(tmp_path / "x.toml")]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}: row 6, column spread: must be the measurement's standard deviation" in err
+
+
+def test_an_existing_file_needs_force(calibrated, capsys) -> None:
+    assert main(["calibrate", *TABLES, "-o", str(calibrated)]) == 2
+    assert "use --force" in capsys.readouterr().err
