@@ -90,7 +90,7 @@ def residual_figure(
 ) -> Figure:
     """Normalised residuals z = (model − measured)/sd of every row: in-sample (the fit to all
     tables, dots) and out-of-sample (the fit without the row's table, squares, z against the
-    combined spread); the band |z| ≤ 2 shaded."""
+    combined spread); the band −2 ≤ z ≤ 2 shaded."""
     fig = new_figure(6.4, 0.9 + 0.45 * max(len(groups), 1))
     ax = fig.add_subplot()
     ax.axvspan(-2, 2, color="tab:green", alpha=0.08, lw=0)
