@@ -52,6 +52,7 @@ _LAZY = {
     "natural_field": "rotomorph.materials.natural",
     "FilamentModel": "rotomorph.materials.natural",
     "get_material": "rotomorph.materials.material",
+    "load_materials": "rotomorph.io.materials_file",
     "MachineProfile": "rotomorph.io.machine",
     "load_machine_profile": "rotomorph.io.machine",
 }

@@ -99,3 +99,22 @@ def test_bad_table_names_file_row_and_column(tmp_path, capsys) -> None:
 def test_an_existing_file_needs_force(calibrated, capsys) -> None:
     assert main(["calibrate", *TABLES, "-o", str(calibrated)]) == 2
     assert "use --force" in capsys.readouterr().err
+
+
+def test_lattice_rows_are_predicted_by_a_contact_resolved_ramp(tmp_path) -> None:
+    from rotomorph.simulate.ink_calibration import calibrate_files
+
+    lattice = tmp_path / "lattice.csv"
+    lattice.write_text(
+        "quantity,condition,x,x_unit,value,spread,unit,source\n"
+        "lattice_area,pattern=expanding; n=3; l=5 mm; A=1.25 mm; v=3 mm/s; layers=1; "
+        "ghost_nodes=4,,,99,11,%,a small test lattice\n",
+        encoding="utf-8",
+    )
+    tables = [INKS / "filaments.csv", INKS / "inks.csv", lattice]
+    run = calibrate_files(tables, tmp_path / "inks.toml", figures=False)
+    (row,) = run.validation
+    assert row.predicted is not None and 0.0 < row.predicted < 200.0  # an expanding lattice
+    assert "contact-resolved" in row.how
+    skipped = calibrate_files(tables, tmp_path / "skip.toml", lattices=False, figures=False)
+    assert skipped.validation[0].predicted is None

@@ -3,6 +3,9 @@
 Public entry points (see each module for the physics and its sources):
 
 * :func:`get_material`, :func:`register_material`, :class:`Material` (``material``)
+* materials files as values: :class:`MaterialSet`, :func:`default_materials` (the paper's
+  inks), :func:`materials_from_mapping` (``parameter_set``); a lab's calibration from its
+  tables: :func:`~rotomorph.materials.lab_calibration.calibrate_tables`
 * :func:`load_table` of the paper's measured values (``measurements``)
 * process model: :func:`dimensionless_rotation`, :func:`order_parameter`,
   :class:`WarnerTerentjev`, :class:`EmpiricalThreshold`, :func:`actuation_fraction` (``process``)
@@ -26,6 +29,11 @@ from rotomorph.materials.material import (
 from rotomorph.materials.measurements import MeasuredTable, load_table, table_names
 from rotomorph.materials.morphology import HelixShape, free_helix
 from rotomorph.materials.natural import FilamentModel, NaturalField, natural_field
+from rotomorph.materials.parameter_set import (
+    MaterialSet,
+    default_materials,
+    materials_from_mapping,
+)
 from rotomorph.materials.process import (
     ActuationStrainModel,
     EmpiricalThreshold,
@@ -45,12 +53,14 @@ __all__ = [
     "FilamentSection",
     "HelixShape",
     "Material",
+    "MaterialSet",
     "MeasuredTable",
     "NaturalField",
     "WarnerTerentjev",
     "actuation_fraction",
     "blend_material",
     "calibrate",
+    "default_materials",
     "dimensionless_rotation",
     "filament_section",
     "free_helix",
@@ -59,6 +69,7 @@ __all__ = [
     "helix_angle_profile",
     "known_materials",
     "load_table",
+    "materials_from_mapping",
     "natural_field",
     "order_parameter",
     "predict",

@@ -37,7 +37,7 @@ from rotomorph.materials.lab_model import InkPair, curve
 from rotomorph.materials.lab_tables import QUANTITIES, Measurement
 from rotomorph.materials.natural import natural_field
 from rotomorph.rod.model import Model
-from rotomorph.simulate.free_shape import free_equilibrium
+from rotomorph.simulate.free_shape import free_equilibrium, min_clearance
 from rotomorph.simulate.ink_report import report_markdown
 
 __all__ = ["CalibrationRun", "ValidationRow", "calibrate_files", "predict_validation"]
@@ -119,16 +119,20 @@ def _sinusoid(m: Measurement, pair: InkPair, names: tuple[str, str], inks: Any) 
     return Filament.model_validate(data, context={"materials": inks}).to_program()
 
 
-def _sinusoid_ratio(program: Any, pair: InkPair, resolution: int) -> float:
+def _sinusoid_shape(program: Any, pair: InkPair, resolution: int) -> FloatArray:
     mats = {program.active_material: pair.active, program.passive_material: pair.passive}
     model = replace(pair.model, resolution=resolution)
     field_ = natural_field(program, mats, model.actuation_temperature, model=model)
-    shape = free_equilibrium(Model.from_field(program.points, field_))
+    return free_equilibrium(Model.from_field(program.points, field_))
+
+
+def _sinusoid_ratio(program: Any, pair: InkPair, resolution: int) -> float:
+    shape = _sinusoid_shape(program, pair, resolution)
     p = program.points
     return float(np.linalg.norm(shape[-1] - shape[0]) / np.linalg.norm(p[-1] - p[0]))
 
 
-def _lattice_area(m: Measurement, cal: LabCalibration) -> float:
+def _lattice_area(m: Measurement, cal: LabCalibration) -> tuple[float, str]:
     from rotomorph.design.lattices import sinusoidal_lattice
     from rotomorph.lattice.actuation import ProgramActuation
     from rotomorph.lattice.heating import heat_lattice, lattice_buoyancy
@@ -159,7 +163,20 @@ def _lattice_area(m: Measurement, cal: LabCalibration) -> float:
         floor=True,
         gravity=lattice_buoyancy(lattice, density=_density(a, p, 0.5, inks)),
     )
-    return 100.0 * (float(result.final_area_ratio) - 1.0)
+    stable = result.stable[-1] if result.stable else None
+    clearance = float(result.min_clearance[-1])
+    verdict = (
+        "physical"
+        if stable is True and clearance >= 1.0 - 1e-6
+        else "NOT PHYSICAL"
+        if stable is False or clearance < 1.0 - 1e-6
+        else "stability not checked"
+    )
+    state = (
+        f"{verdict}: final state {'certified stable' if stable else 'not certified stable'}, "
+        f"closest approach {clearance:.2f} diameters"
+    )
+    return 100.0 * (float(result.final_area_ratio) - 1.0), state
 
 
 def predict_validation(cal: LabCalibration, *, lattices: bool = True) -> tuple[ValidationRow, ...]:
@@ -176,21 +193,31 @@ def predict_validation(cal: LabCalibration, *, lattices: bool = True) -> tuple[V
                 return np.array([_sinusoid_ratio(program, pair, 96)])
 
             value, sd = cal.fit.propagate(ratio, central=False)
+            diameter = 2.0 * cal.base.radius
+            gap = (
+                min_clearance(
+                    _sinusoid_shape(program, cal.fit.model, 96), exclude_arc=2.0 * diameter
+                )
+                / diameter
+            )
+            state = "physical" if gap >= 1.0 else "NOT PHYSICAL (passes through itself)"
             out.append(
                 ValidationRow(
                     m, float(value[0]), float(sd[0]),
-                    f"zero-energy free shape, ideal flips, spacing {SINUSOID_SPACING} mm",
+                    f"zero-energy free shape, ideal flips, spacing {SINUSOID_SPACING} mm; "
+                    f"{state}: closest approach {gap:.2f} diameters",
                 )
             )  # fmt: skip
         elif not lattices:
             out.append(ValidationRow(m, None, None, "not computed (--no-lattices)"))
         else:
             logger.info("validation: %s lattice ramp (%s)", m.conditions["pattern"], m.label)
+            area, state = _lattice_area(m, cal)
             out.append(
                 ValidationRow(
-                    m, _lattice_area(m, cal), None,
+                    m, area, None,
                     f"contact-resolved ramp on the bath floor, buoyant weight, {LATTICE_STEPS} "
-                    "steps, no calibration sd",
+                    f"steps, no calibration sd; {state}",
                 )
             )  # fmt: skip
     return tuple(out)
