@@ -38,6 +38,10 @@ def lab_document(gain: float | None = None) -> dict:
     doc["name"] = "lab-inks"
     doc["inks"] = {"rm257": doc["inks"]["lce"], "pdms": doc["inks"]["acrylate"]}
     doc["inks"]["rm257"]["actuated_modulus_ratio"]["relative_to"] = "pdms"
+    cal = doc["calibration"]
+    cal["parameters"] = [
+        p.replace("lce.", "rm257.").replace("acrylate.", "pdms.") for p in cal["parameters"]
+    ]
     if gain is not None:
         doc["inks"]["rm257"]["strain_gain"]["value"] = gain
     return doc
@@ -242,3 +246,18 @@ def test_inverse_designs_with_the_lab_inks_and_names_them(lab, tmp_path, capsys)
             },
             lab,
         )
+
+
+def test_the_predict_command_gives_the_paper_twins_numbers_and_band(lab, capsys) -> None:
+    assert main(["predict", str(lab / "design.toml"), "--json"]) == 0
+    mine = json.loads(capsys.readouterr().out)
+    assert main(["predict", str(lab / "paper.toml"), "--json"]) == 0
+    twin = json.loads(capsys.readouterr().out)
+    assert mine["materials"]["sha256"] == load_materials(lab / "inks" / "lab.toml").sha256
+    assert twin["materials"] is None
+    for a, b in zip(mine["filaments"], twin["filaments"], strict=True):
+        assert a["method"] == b["method"] and not a["extrapolation"]
+        for key, q in a["quantities"].items():
+            ref = b["quantities"][key]
+            assert q["value"] == pytest.approx(ref["value"], rel=1e-9, abs=1e-12), key
+            assert q["sd_calibration"] == pytest.approx(ref["sd_calibration"], rel=1e-6), key

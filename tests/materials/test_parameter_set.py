@@ -40,7 +40,7 @@ def test_the_default_file_is_the_default_model_and_registry() -> None:
     default = FilamentModel()
     assert dataclasses.replace(model, materials=None) == default  # every field, exactly
     assert model.materials is PAPER and default.materials is None
-    assert model.modulus_ratio == CALIBRATED["modulus_ratio"] == 2.10427324502607
+    assert model.modulus_ratio == CALIBRATED["modulus_ratio"] == 3.9764259028134044
     assert model.strain_model.order_points == ((0.25, 0.150), (3.0, 0.230))
     for name in ("lce", "acrylate"):
         registered, from_file = get_material(name), PAPER.material(name)
@@ -71,6 +71,30 @@ def test_stored_calibration_is_a_fresh_one_of_the_hashed_tables() -> None:
     ]
     assert PAPER.document.calibration is not None
     assert PAPER.document.calibration.data_sha256 == data_sha256(data)
+
+
+def test_the_stored_covariance_is_the_calibrations_and_propagates_alike() -> None:
+    import numpy as np
+
+    from rotomorph.materials.calibrate import janus_curvature
+
+    fit = PAPER.calibration_fit("lce", "acrylate")
+    fresh = paper_calibration().chosen
+    assert fit is not None and [p.name for p in fit.parameters] == [
+        p.name for p in fresh.parameters
+    ]
+    sym = 0.5 * (fresh.covariance + fresh.covariance.T)
+    assert np.allclose(fit.covariance, sym, rtol=1e-6, atol=1e-15)
+
+    def curvature(model: FilamentModel) -> np.ndarray:
+        return janus_curvature(model, np.array([0.5, 3.0]))
+
+    assert np.allclose(fit.propagate(curvature)[1], fresh.propagate(curvature)[1], rtol=1e-6)
+    # another passive ink: its free strain is not the calibrated one, so it is left out
+    doc = copy.deepcopy(DOC)
+    doc["inks"]["other"] = copy.deepcopy(doc["inks"]["acrylate"])
+    other = materials_from_mapping(doc).calibration_fit("lce", "other")
+    assert other is not None and "passive_strain" not in [p.name for p in other.parameters]
 
 
 def test_every_value_has_unit_provenance_and_source_and_tni_is_a_placeholder() -> None:
@@ -126,7 +150,7 @@ def test_the_ratio_is_kept_relative_to_its_passive_ink() -> None:
     doc["inks"]["stiffer"] = stiff
     inks = materials_from_mapping(doc)
     m = inks.modulus_ratio("lce", "acrylate")
-    assert m == 2.10427324502607
+    assert m == 3.9764259028134044
     assert inks.modulus_ratio("lce", "stiffer") == pytest.approx(m / 2.0)
     assert inks.filament_model("lce", "stiffer").modulus_ratio == pytest.approx(m / 2.0)
     with pytest.raises(MaterialError, match="passive ink"):
@@ -200,6 +224,13 @@ _DELETE = object()
             "temperature difference",
         ),
         ("schema_version", 2, "schema_version", "1"),
+        ("calibration.covariance", [[1.0]], "calibration.covariance", "one row"),
+        (
+            "calibration.parameters",
+            ["lce.strain_gain", "pla.strain_gain", "lce.strain_threshold", "acrylate.free_strain"],
+            "calibration.parameters",
+            "names no value",
+        ),
     ],
 )
 def test_bad_materials_give_one_line_naming_the_key(path, value, field, message) -> None:

@@ -607,6 +607,15 @@ def _materials_set(
             "determined": [FILE_KEYS[n][1] for n in after.determined],
             "at_prior": [FILE_KEYS[n][1] for n in after.at_prior],
             "report": settings.report,
+            "parameters": [
+                f"{active_name if FILE_KEYS[p.name][0] == 'active' else passive_name}."
+                f"{FILE_KEYS[p.name][1]}"
+                for p in params
+            ],
+            "coordinates": ["ln" if p.log else "linear" for p in params],
+            "covariance": [
+                [float(x) for x in row] for row in 0.5 * (fit.covariance + fit.covariance.T)
+            ],
         },
         "inks": {active_name: active, passive_name: passive},
     }

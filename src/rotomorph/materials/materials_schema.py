@@ -298,7 +298,13 @@ Ink = Annotated[ActiveInk | PassiveInk, Field(discriminator="kind")]
 
 
 class CalibrationRecord(_Model):
-    """How the calibrated values were obtained (written by ``rotomorph calibrate``)."""
+    """How the calibrated values were obtained (written by ``rotomorph calibrate``).
+
+    ``parameters`` (``ink.key`` of the fitted values), ``coordinates`` (``ln`` or ``linear``:
+    the fit coordinate of each) and ``covariance`` (the posterior covariance in those
+    coordinates) carry the calibration's uncertainty to predictions (``rotomorph predict``'s
+    band).
+    """
 
     method: Text
     tables: list[Text] = Field(default_factory=list)
@@ -308,6 +314,30 @@ class CalibrationRecord(_Model):
     determined: list[str] = Field(default_factory=list)
     at_prior: list[str] = Field(default_factory=list)
     report: Text = ""
+    parameters: list[str] = Field(default_factory=list, max_length=20)
+    coordinates: list[Literal["ln", "linear"]] = Field(default_factory=list, max_length=20)
+    covariance: list[list[float]] = Field(default_factory=list, max_length=20)
+
+    @model_validator(mode="after")
+    def _covariance(self) -> CalibrationRecord:
+        n = len(self.parameters)
+        if len(self.coordinates) != n or len(self.covariance) != n:
+            raise ValueError(
+                "covariance: needs one row, and coordinates one entry, per parameter "
+                f"({n} parameters)"
+            )
+        for i, row in enumerate(self.covariance):
+            if len(row) != n:
+                raise ValueError(f"covariance: row {i} has {len(row)} entries, not {n}")
+            if row[i] < 0:
+                raise ValueError(f"covariance: a variance must be >= 0; got {row[i]} at [{i}][{i}]")
+            for j in range(i):
+                if abs(row[j] - self.covariance[j][i]) > 1e-9 * (1.0 + abs(row[j])):
+                    raise ValueError(f"covariance: must be symmetric; [{i}][{j}] != [{j}][{i}]")
+        for name in self.parameters:
+            if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}\.[a-z_]+", name):
+                raise ValueError(f"parameters: {name!r} is not 'ink.key'")
+        return self
 
 
 class MaterialsDocument(_Model):
@@ -325,6 +355,14 @@ class MaterialsDocument(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> MaterialsDocument:
+        for key in self.calibration.parameters if self.calibration is not None else ():
+            ink_name, _, value_key = key.rpartition(".")
+            ink = self.inks.get(ink_name)
+            if ink is None or not isinstance(getattr(ink, value_key, None), Value):
+                raise ValueError(
+                    f"calibration.parameters: {key!r} names no value of this file's inks "
+                    "(ink.key)"
+                )
         for name, ink in self.inks.items():
             if not INK_NAME.match(name):
                 shown = name.encode("unicode_escape").decode("ascii")

@@ -16,12 +16,15 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from importlib import resources
 from typing import TYPE_CHECKING, Any, Final
 
+import numpy as np
+
 from rotomorph.errors import MaterialError
+from rotomorph.materials.inference import Fit, Parameter, get_parameter
 from rotomorph.materials.material import Material
 from rotomorph.materials.materials_schema import (
     ActiveInk,
@@ -235,6 +238,59 @@ class MaterialSet:
                 "passive_material", f"{name!r} is an active ink; give a passive one"
             )
         return ink
+
+    def calibration_fit(
+        self, active: str, passive: str, *, resolution: int | None = 64
+    ) -> Fit | None:
+        """The calibration's posterior for the pair's model, for propagating its uncertainty
+        (:meth:`~rotomorph.materials.inference.Fit.propagate`), or ``None`` when the file stores
+        no covariance (``[calibration] parameters, coordinates, covariance``).
+
+        The fitted values that are fields of the pair's model (the modulus ratio, the strain
+        law's gain and threshold, the passive free strain when ``passive`` is the calibrated
+        ink, the transition width) keep their joint covariance; the others (T_NI) are
+        marginalised out (their block of the covariance dropped). ``resolution`` is the section
+        mesh of the sensitivities (the fit's; ``None``: the model's default).
+        """
+        cal = self.document.calibration
+        if cal is None or not cal.parameters:
+            return None
+        keys = {
+            f"{active}.actuated_modulus_ratio": "modulus_ratio",
+            f"{active}.strain_gain": "strain_model.gain",
+            f"{active}.strain_threshold": "strain_model.threshold",
+            f"{active}.transition_width": "transition_width",
+            f"{passive}.free_strain": "passive_strain",
+        }
+        model = self.filament_model(active, passive)
+        if resolution is not None:
+            model = replace(model, resolution=resolution)
+        rows = [i for i, name in enumerate(cal.parameters) if name in keys]
+        if not rows:
+            return None
+        cov = np.array(cal.covariance, dtype=float)[np.ix_(rows, rows)]
+        params, theta = [], []
+        for k, i in enumerate(rows):
+            name = keys[cal.parameters[i]]
+            log = cal.coordinates[i] == "ln"
+            value = float(get_parameter(model, name))
+            t = math.log(value) if log else value
+            sd = math.sqrt(max(cov[k, k], 0.0)) or 1e-12
+            params.append(Parameter(name, t, sd, log=log, reason="from the materials file"))
+            theta.append(t)
+        return Fit(
+            label=cal.chosen_branch or "materials file",
+            parameters=tuple(params),
+            theta=np.array(theta),
+            covariance=cov,
+            model=model,
+            chi2_data=float("nan"),
+            chi2_prior=float("nan"),
+            n_data=0,
+            at_bound=(),
+            success=True,
+            base=model,
+        )
 
     # -- provenance ----------------------------------------------------------------------
     def values(self) -> list[ValueRow]:

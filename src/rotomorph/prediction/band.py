@@ -14,12 +14,19 @@ the Janus-curvature series (at ω* = 0) and rotation numbers of the L/L0 series 
 all heated to 175 °C, filaments of radius 0.3 mm with half (composite) or all (pure LCE) of the
 section active. A setting outside it is an extrapolation of the fitted laws and is flagged as
 one wherever it is reported.
+
+A design that names its own materials file is predicted with that file's inks and model:
+:func:`calibration_of` makes the nominal model, the band (the file's stored posterior
+covariance; none when the file stores none) and the calibrated range those of the file's pair
+while a prediction runs.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -27,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from rotomorph._typing import FloatArray
+from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.calibrate import PAPER_RADIUS, ROTATION_SERIES_SPEED
 from rotomorph.materials.inference import Fit
 from rotomorph.materials.measurements import load_table
@@ -38,8 +46,12 @@ __all__ = [
     "CALIBRATION_TEMPERATURE",
     "CalibratedRange",
     "Estimate",
+    "calibrated_inks",
+    "calibrated_materials",
     "calibrated_range",
+    "calibrated_set",
     "calibration_fit",
+    "calibration_of",
     "nominal_model",
     "with_band",
 ]
@@ -139,10 +151,11 @@ class CalibratedRange:
                 f"active fraction {active_fraction:g}: the calibration has 0.5 (Janus) and 1 "
                 "(pure LCE)"
             )
-        if materials is not None and tuple(materials) != CALIBRATED_MATERIALS:
+        known = calibrated_materials()
+        if materials is not None and tuple(materials) != known:
             out.append(
                 f"materials {materials[0]}/{materials[1]}: the calibration is for "
-                f"{CALIBRATED_MATERIALS[0]}/{CALIBRATED_MATERIALS[1]} (its band does not apply)"
+                f"{known[0]}/{known[1]} (its band does not apply)"
             )
         return out
 
@@ -152,8 +165,89 @@ def _span(x: FloatArray) -> str:
     return f"{lo:.4g}" if math.isclose(lo, hi) else f"{lo:.4g}-{hi:.4g}"
 
 
-@lru_cache(maxsize=1)
+@dataclass(frozen=True, eq=False)
+class _FileCalibration:
+    """A materials file's pair, while :func:`calibration_of` holds it."""
+
+    materials: Any
+    names: tuple[str, str]
+    fit: Fit | None
+    nominal: FilamentModel
+    range: CalibratedRange
+
+
+_FILE: ContextVar[_FileCalibration | None] = ContextVar("rotomorph_prediction_file", default=None)
+
+
+def _file_range(materials: Any) -> CalibratedRange:
+    """Where a materials file's calibration was measured: its order parameter's speeds, the
+    nozzle's radius, its actuation temperature (the file stores no ω* range: the paper's)."""
+    doc = materials.document
+    active = next(iter(materials.names("active")), None)
+    speeds = [1.0] if active is None else [v for v, _ in materials.order_points(active)]
+    return CalibratedRange(
+        speed=(float(min(speeds)), float(max(speeds))),
+        rotation_number=_paper_range().rotation_number,
+        rotation_speed=ROTATION_SERIES_SPEED,
+        temperature=float(doc.conditions.actuation_temperature.value),
+        radius=float(doc.nozzle.filament_radius.value),
+    )
+
+
+@contextlib.contextmanager
+def calibration_of(materials: Any, active: str, passive: str) -> Iterator[None]:
+    """Predict with ``materials``' pair (a :class:`~rotomorph.materials.parameter_set.MaterialSet`)
+    inside the block; ``materials = None``: the paper's calibration (no change)."""
+    if materials is None:
+        yield
+        return
+    from rotomorph.simulate.validation import at_resolution
+
+    nominal = at_resolution(materials.filament_model(active, passive))
+    state = _FileCalibration(
+        materials,
+        (active, passive),
+        materials.calibration_fit(active, passive),
+        nominal,
+        _file_range(materials),
+    )
+    token = _FILE.set(state)
+    try:
+        yield
+    finally:
+        _FILE.reset(token)
+
+
+def calibrated_materials() -> tuple[str, str]:
+    """The (active, passive) inks the current calibration is for."""
+    state = _FILE.get()
+    return CALIBRATED_MATERIALS if state is None else state.names
+
+
+def calibrated_inks() -> tuple[Any, Any]:
+    """The current calibration's two inks as :class:`~rotomorph.materials.material.Material` s."""
+    state = _FILE.get()
+    if state is None:
+        from rotomorph.materials.material import get_material
+
+        return get_material(CALIBRATED_MATERIALS[0]), get_material(CALIBRATED_MATERIALS[1])
+    return state.materials.material(state.names[0]), state.materials.material(state.names[1])
+
+
+def calibrated_set() -> Any:
+    """The materials file of the current calibration (``None``: the paper's inks)."""
+    state = _FILE.get()
+    return None if state is None else state.materials
+
+
 def calibrated_range() -> CalibratedRange:
+    """The calibrated range of the current calibration (the paper's, or a materials file's)."""
+    state = _FILE.get()
+    return _paper_range() if state is None else state.range
+
+
+@lru_cache(maxsize=1)
+def _paper_range() -> CalibratedRange:
     """The calibrated range, read from the measured tables the calibration fits."""
     speeds = load_table("janus_curvature").x
     omegas = np.concatenate([load_table(g).x for g in ("pure_lce_length", "composite_length")])
@@ -166,8 +260,22 @@ def calibrated_range() -> CalibratedRange:
     )
 
 
-@lru_cache(maxsize=1)
 def calibration_fit() -> Fit:
+    """The current calibration's fit: the report's (below), or a materials file's stored
+    posterior (:func:`calibration_of`; raises when the file stores none)."""
+    state = _FILE.get()
+    if state is None:
+        return _paper_fit()
+    if state.fit is None:
+        raise InvalidParameterError(
+            "materials",
+            f"{state.materials.name!r} stores no calibration covariance: no band to propagate",
+        )
+    return state.fit
+
+
+@lru_cache(maxsize=1)
+def _paper_fit() -> Fit:
     """The chosen fit of the joint calibration on all filament groups (the report's).
 
     About half a second of CPU the first time; kept in the package's disk cache
@@ -180,9 +288,13 @@ def calibration_fit() -> Fit:
 
 
 def nominal_model() -> FilamentModel:
-    """The calibrated model on the report's section mesh (its Fig. 2 curves use this one)."""
+    """The calibrated model on the report's section mesh (its Fig. 2 curves use this one);
+    inside :func:`calibration_of`, the materials file's model of its pair."""
     from rotomorph.simulate.validation import at_resolution
 
+    state = _FILE.get()
+    if state is not None:
+        return state.nominal
     return at_resolution(calibration_fit().model)
 
 
@@ -232,8 +344,11 @@ def with_band(quantity: Callable[[FilamentModel], FloatArray], units: list[str])
     ``quantity`` returns one number per entry of ``units``. The value is taken on the report's
     mesh (:func:`nominal_model`), the sensitivities on the fit's mesh, as the report does.
     """
-    fit = calibration_fit()
+    state = _FILE.get()
     value = np.asarray(quantity(nominal_model()), dtype=float)
+    if state is not None and state.fit is None:  # a file without a stored covariance
+        return [Estimate(float(v), None, u) for v, u in zip(value, units, strict=True)]
+    fit = calibration_fit()
     with np.errstate(invalid="ignore"):
         _, sd = fit.propagate(quantity)
     return [

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from rotomorph.prediction.band import CALIBRATION_TEMPERATURE, calibrated_range
+from rotomorph.prediction.band import CALIBRATION_TEMPERATURE, calibrated_range, calibration_of
 from rotomorph.prediction.filament import FilamentPrediction, predict_filament
 from rotomorph.prediction.lattice import LatticePrediction, predict_lattice
 
@@ -26,12 +26,17 @@ class DesignPrediction:
         One prediction per filament (empty for a lattice).
     lattice
         The lattice's independent-edge estimate, or ``None``.
+    materials, range_record
+        The design's materials file (name, version, sha256) and its calibrated range, when it
+        names one (``None``: the paper's inks).
     """
 
     name: str
     temperature: float
     filaments: tuple[FilamentPrediction, ...]
     lattice: LatticePrediction | None
+    materials: dict[str, Any] | None = None
+    range_record: dict[str, Any] | None = None
 
     @property
     def extrapolated(self) -> bool:
@@ -46,7 +51,8 @@ class DesignPrediction:
             "temperature_C": self.temperature,
             "band": "calibration only (posterior of the joint filament calibration, as the "
             "paper report); inputs the paper does not give are not in it",
-            "calibrated_range": calibrated_range().record(),
+            "calibrated_range": self.range_record or calibrated_range().record(),
+            "materials": self.materials,
             "extrapolated": self.extrapolated,
             "filaments": [f.record() for f in self.filaments],
             "lattice": None if self.lattice is None else self.lattice.record(),
@@ -72,11 +78,20 @@ def predict_design(
     temperature
         Heating temperature (°C); the calibration's is 175 °C.
     """
-    filaments = tuple(
-        predict_filament(f.to_program(), f.name or f"filaments[{i}]", temperature=temperature)
-        for i, f in enumerate(design.filaments)
-    )
+    inks = design.material_set  # a design's own materials file: its pairs' models and bands
+    filaments = []
+    for i, f in enumerate(design.filaments):
+        with calibration_of(inks, f.active_material, f.passive_material):
+            name = f.name or f"filaments[{i}]"
+            filaments.append(predict_filament(f.to_program(), name, temperature=temperature))
     lattice = None
     if design.lattice is not None:
-        lattice = predict_lattice(design.lattice, temperature=temperature)
-    return DesignPrediction(design.name, float(temperature), filaments, lattice)
+        lat = design.lattice
+        with calibration_of(inks, lat.active_material, lat.passive_material):
+            lattice = predict_lattice(lat, temperature=temperature)
+    if inks is None:
+        return DesignPrediction(design.name, float(temperature), tuple(filaments), lattice)
+    with calibration_of(inks, inks.names("active")[0], inks.names("passive")[0]):
+        rng = calibrated_range().record()
+    record = {**inks.record(), "band": "the materials file's stored posterior covariance"}
+    return DesignPrediction(design.name, float(temperature), tuple(filaments), lattice, record, rng)

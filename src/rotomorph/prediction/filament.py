@@ -29,14 +29,14 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.materials.calibrate import filament_shapes
-from rotomorph.materials.material import get_material
 from rotomorph.materials.morphology import HelixShape
 from rotomorph.materials.natural import DIRECTOR_HELIX_SENSE, FilamentModel, natural_field
 from rotomorph.materials.process import strain_to_stretch
 from rotomorph.prediction.band import (
-    CALIBRATED_MATERIALS,
     CALIBRATION_TEMPERATURE,
     Estimate,
+    calibrated_inks,
+    calibrated_materials,
     calibrated_range,
     with_band,
 )
@@ -131,7 +131,7 @@ def _closed_form_settings(program: Any, temperature: float) -> tuple[float, floa
     """``(speed, rotation number)`` when the report's closed form applies, else ``None``."""
     if abs(temperature - CALIBRATION_TEMPERATURE) > 1e-9:
         return None
-    if (program.active_material, program.passive_material) != CALIBRATED_MATERIALS:
+    if (program.active_material, program.passive_material) != calibrated_materials():
         return None
     if np.max(np.abs(program.path.curvature)) > 1e-9:
         return None
@@ -145,7 +145,7 @@ def _closed_form_settings(program: Any, temperature: float) -> tuple[float, floa
 
 def _stretch(model: FilamentModel, w: float, fraction: float, speed: float, radius: float) -> float:
     """Natural stretch of the centre line of a straight filament (closed form)."""
-    active, passive = get_material(CALIBRATED_MATERIALS[0]), get_material(CALIBRATED_MATERIALS[1])
+    active, passive = calibrated_inks()
     section = model.section(active, passive, radius, fraction)
     e_par, e_perp, eps_p = model.strains(np.array([speed]), passive)
     eps_c, _, _ = section.natural_strains(DIRECTOR_HELIX_SENSE * w, e_par, e_perp, eps_p)
@@ -235,13 +235,19 @@ def predict_filament(
     if closed is not None:
         v, w = closed
 
+        inks = calibrated_inks()
+
         def helix(model: FilamentModel) -> FloatArray:
-            shape = filament_shapes(model, np.array([w]), fraction, speed=v, radius=radius)[0]
+            shape = filament_shapes(
+                model, np.array([w]), fraction, speed=v, radius=radius, inks=inks
+            )[0]
             return np.array(_helix_values(shape))
 
         est = with_band(helix, [_UNITS[k] for k in HELIX_QUANTITIES])
         model = nominal_model()
-        shape = filament_shapes(model, np.array([w]), fraction, speed=v, radius=radius)[0]
+        shape = filament_shapes(model, np.array([w]), fraction, speed=v, radius=radius, inks=inks)[
+            0
+        ]
         length = printed * _stretch(model, w, fraction, v, radius)
         return _helix_prediction(
             name, "closed form (section + free helix)", est, shape, length, radius, extrapolated,

@@ -94,6 +94,7 @@ class LatticePrediction:
 def _edge_program(lattice: Any, mode: str, speed: float, spacing: float) -> Any:
     """One lattice edge printed on its own: a sine period with the edge's side and speed."""
     from rotomorph.io.designfile import Filament
+    from rotomorph.prediction.band import calibrated_set
 
     return Filament.model_validate(
         {
@@ -114,7 +115,8 @@ def _edge_program(lattice: Any, mode: str, speed: float, spacing: float) -> Any:
                     "periods": 1,
                 }
             ],
-        }
+        },
+        context={"materials": calibrated_set()},  # the design's inks, if it names a file
     ).to_program()
 
 
