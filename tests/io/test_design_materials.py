@@ -227,7 +227,7 @@ def test_inverse_designs_with_the_lab_inks_and_names_them(lab, tmp_path, capsys)
     assert design.filaments[0].active_material == "rm257"
     assert not Path(str(design.materials)).is_absolute()
     summary = json.loads((tmp_path / "designs" / "helix_inverse" / "summary.json").read_text())
-    assert summary["rms_error_rel"] < 1e-3
+    assert summary["rms_error_rel"] < 0.005  # the default tolerance of options.tolerance
     with pytest.raises(InvalidDesignError, match=r"options\.active_material"):
         from rotomorph.inverse.targets import parse_target
 

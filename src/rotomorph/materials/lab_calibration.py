@@ -10,18 +10,17 @@ one decade, both branches), the threshold strain law's gain and threshold S0, th
 strain, T_NI and the width of the transition. Used as measured (inputs): both inks' moduli at
 the print temperature, the order parameter's points, and the glass transitions, densities and
 Poisson ratios given. Before fitting, :func:`~rotomorph.materials.identifiability.identifiability`
-says which parameters the tables determine; a table set that cannot determine the strain law or
-the modulus ratio is refused (:class:`~rotomorph.errors.InvalidParameterError`, one line naming
-the missing measurement). :func:`calibrate_tables` returns the fit, the identifiability before
+says which parameters the tables determine; a table set that cannot determine the strain law
+(its gain and threshold), or that lacks either ink's modulus at the print temperature, is
+refused (:class:`~rotomorph.errors.InvalidParameterError`, one line naming the missing
+measurement). :func:`calibrate_tables` returns the fit, the identifiability before
 and after it, the leave-one-group-out predictions and the :class:`MaterialSet` to write.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import PurePath
 from typing import Any, Final
 
 import numpy as np
@@ -30,15 +29,19 @@ from rotomorph._typing import FloatArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.identifiability import Identifiability, identifiability
 from rotomorph.materials.inference import Fit, Group, JointCalibration, Parameter, joint_calibrate
+from rotomorph.materials.lab_inputs import groups as group_rows
+from rotomorph.materials.lab_inputs import ink_inputs, order_points
+from rotomorph.materials.lab_materials import FILE_KEYS, materials_set
 from rotomorph.materials.lab_model import InkPair, predictor
 from rotomorph.materials.lab_tables import Measurement, MeasurementSet, table
 from rotomorph.materials.material import Material
 from rotomorph.materials.natural import FilamentModel
-from rotomorph.materials.parameter_set import MaterialSet, materials_from_mapping
-from rotomorph.materials.process import PAPER_ORDER_POINTS, EmpiricalThreshold, order_parameter
+from rotomorph.materials.parameter_set import MaterialSet
+from rotomorph.materials.process import EmpiricalThreshold, order_parameter
 
 __all__ = [
     "ESSENTIAL",
+    "FILE_KEYS",
     "HINTS",
     "LABELS",
     "CalibrationSettings",
@@ -72,27 +75,9 @@ HINTS: Final = {
 }
 #: Parameters without which the tables do not determine the printed shapes: refused.
 ESSENTIAL: Final = ("model.strain_model.gain", "model.strain_model.threshold")
-#: Keys of the materials file the fitted parameters are written to: (ink role, key).
-FILE_KEYS: Final = {
-    "model.modulus_ratio": ("active", "actuated_modulus_ratio"),
-    "model.strain_model.gain": ("active", "strain_gain"),
-    "model.strain_model.threshold": ("active", "strain_threshold"),
-    "model.passive_strain": ("passive", "free_strain"),
-    "active.transition_temperature": ("active", "transition_temperature"),
-    "model.transition_width": ("active", "transition_width"),
-}
 BRANCH_REASON: Final = (
     "E_a >= E_p at actuation assumed: no table distinguishes the two branches of the bilayer "
     "symmetry; measure both inks' moduli at the actuation temperature to decide"
-)
-GROUPS: Final = (
-    ("janus_curvature", None),
-    ("pure_lce_length", None),
-    ("composite_length", None),
-    ("free_length", "active"),
-    ("free_length", "passive"),
-    ("youngs_modulus", "active"),
-    ("youngs_modulus", "passive"),
 )
 
 
@@ -156,37 +141,6 @@ class LabCalibration:
     def group_rows(self, name: str) -> tuple[Measurement, ...]:
         """The measurements of one fitted group."""
         return self.inputs["rows"][name]  # type: ignore[no-any-return]
-
-
-def _weighted(rows: Sequence[Measurement]) -> tuple[float, float]:
-    w = np.array([1.0 / m.spread**2 for m in rows])
-    v = np.array([m.value for m in rows])
-    return float(np.sum(w * v) / np.sum(w)), float(1.0 / math.sqrt(np.sum(w)))
-
-
-def _cite(rows: Sequence[Measurement]) -> str:
-    """``name.csv rows 3, 4 (source)``: the file's name (not its folder: the file written is
-    the same wherever the tables were read from; the data hash identifies them)."""
-    files: dict[str, list[int]] = {}
-    for m in rows:
-        files.setdefault(PurePath(m.file).name, []).append(m.row)
-    parts = [
-        f"{f} row{'s' if len(r) > 1 else ''} {', '.join(map(str, r))}" for f, r in files.items()
-    ]
-    first = rows[0].source if rows else ""
-    return f"{'; '.join(parts)} ({first})" if first else "; ".join(parts)
-
-
-def _provenance(rows: Sequence[Measurement]) -> str:
-    """``cited`` when every row is cited from a publication, else ``measured``."""
-    return "cited" if rows and all(m.provenance == "cited" for m in rows) else "measured"
-
-
-def _value(value: float, unit: str, provenance: str, source: str, **extra: Any) -> dict[str, Any]:
-    out: dict[str, Any] = {"value": float(value), "unit": unit, "provenance": provenance}
-    out["source"] = source
-    out.update({k: v for k, v in extra.items() if v is not None})
-    return out
 
 
 def lab_parameters(
@@ -278,66 +232,6 @@ def _names(data: MeasurementSet, settings: CalibrationSettings) -> tuple[str, st
     return out[0], out[1]
 
 
-def _ink_inputs(
-    data: MeasurementSet, role: str, name: str, t_print: float
-) -> dict[str, tuple[float, float | None, str, str]]:
-    """(value, sd, provenance, source) of an ink's measured or assumed single values."""
-    moduli = [m for m in data.of("youngs_modulus", role) if abs(m.x - t_print) <= 0.5]
-    if not moduli:
-        raise InvalidParameterError(
-            "MEASUREMENTS",
-            f"missing measurement: youngs_modulus of the {role} ink {name!r} at the print "
-            f"temperature {t_print:g} °C (a tensile test; condition {role}={name})",
-        )
-    out: dict[str, tuple[float, float | None, str, str]] = {}
-    e, sd = _weighted(moduli)
-    out["youngs_modulus"] = (e, sd, _provenance(moduli), _cite(moduli))
-    defaults = {
-        "poisson_ratio": (0.5, "incompressible elastomer (no poisson_ratio table)"),
-        "density": (1.1, "typical acrylate elastomer (no density table); only the weight uses it"),
-    }
-    for key in ("poisson_ratio", "density", "glass_transition"):
-        rows = data.of(key, role)
-        if rows:
-            v, s = _weighted(rows)
-            out[key] = (v, s, _provenance(rows), _cite(rows))
-        elif key in defaults:
-            out[key] = (defaults[key][0], None, "assumed", defaults[key][1])
-    return out
-
-
-def _groups(data: MeasurementSet, t_print: float) -> dict[str, tuple[Measurement, ...]]:
-    out: dict[str, tuple[Measurement, ...]] = {}
-    for quantity, role in GROUPS:
-        rows = data.of(quantity, role)
-        if quantity == "youngs_modulus":  # the print-temperature rows are inputs
-            rows = tuple(m for m in rows if abs(m.x - t_print) > 0.5)
-        if rows:
-            out[quantity if role is None else f"{quantity}_{role}"] = rows
-    return out
-
-
-def _order_points(
-    data: MeasurementSet,
-) -> tuple[tuple[tuple[float, float], ...], tuple[float, ...] | None, str, str]:
-    rows = data.of("order_parameter")
-    if not rows:
-        return (
-            PAPER_ORDER_POINTS,
-            None,
-            "assumed",
-            "no order_parameter table: the paper's WAXS points (Abdelrahman et al., Supp. "
-            "Figs 8-9) are assumed; S is then only the coordinate of the strain law",
-        )
-    speeds = sorted({m.x for m in rows})
-    points, sds = [], []
-    for v in speeds:
-        mean, sd = _weighted([m for m in rows if m.x == v])
-        points.append((v, mean))
-        sds.append(sd)
-    return tuple(points), tuple(sds), _provenance(rows), _cite(rows)
-
-
 def _refuse_degenerate(before: Identifiability, groups: dict[str, Any]) -> None:
     if not groups:
         raise InvalidParameterError(
@@ -376,10 +270,10 @@ def calibrate_tables(
         )
     radius = 0.3 if settings.radius is None else float(settings.radius)
     fraction = 0.5 if settings.active_fraction is None else float(settings.active_fraction)
-    a_in = _ink_inputs(data, "active", active_name, t_print)
-    p_in = _ink_inputs(data, "passive", passive_name, t_print)
-    points, point_sd, point_prov, point_src = _order_points(data)
-    rows = _groups(data, t_print)
+    a_in = ink_inputs(data, "active", active_name, t_print)
+    p_in = ink_inputs(data, "passive", passive_name, t_print)
+    points, point_sd, point_prov, point_src = order_points(data)
+    rows = group_rows(data, t_print)
     janus = [m.x for m in rows.get("janus_curvature", ())]
     params = lab_parameters(points, janus, t_print, t_act)
     by = {p.name: p for p in params}
@@ -458,165 +352,7 @@ def calibrate_tables(
         "order_provenance": (point_prov, point_src),
         "names": (active_name, passive_name),
     }
-    inks = _materials_set(data, settings, base, params, joint, after, inputs)
+    inks = materials_set(data, settings, base, params, joint, after, inputs)
     return LabCalibration(
         data, settings, base, params, groups, joint, before, after, held_out, inks, inputs
     )
-
-
-def _fitted_entries(
-    params: Sequence[Parameter], fit: Fit, after: Identifiability, data: MeasurementSet
-) -> dict[str, dict[str, Any]]:
-    """File entries of the fitted parameters: calibrated, or assumed where at the prior."""
-    sd = fit.sd_coordinate
-    intervals = fit.intervals
-    status = {p.name: p for p in after.parameters}
-    out = {}
-    for p in params:
-        role, key = FILE_KEYS[p.name]
-        value = fit.values[p.name]
-        report = status[p.name]
-        prior = (
-            f"ln-normal, ln value ~ N({p.mean:.4g}, {p.sd:.3g})"
-            if p.log
-            else f"N({p.mean:.4g}, {p.sd:.3g})"
-        )
-        if report.status == "at its prior":
-            provenance = "assumed"
-            source = (
-                f"stays at its prior {prior} (posterior/prior width {report.width_ratio:.2f}): "
-                f"no table determines it; {report.pinned_by} would"
-            )
-        else:
-            provenance = "calibrated"
-            tables = ", ".join(t for t, s in report.informed_by if s >= 0.05)
-            source = (
-                f"rotomorph calibrate: maximum a posteriori of the joint fit (prior {prior}), "
-                f"informed by {tables} (posterior/prior width {report.width_ratio:.2f}); data "
-                f"sha256 {data.sha256[:16]}; a fit, not a measurement"
-            )
-        s = sd[p.name] * value if p.log else sd[p.name]
-        entry = _value(value, "1", provenance, source, sd=float(s))
-        if p.log:
-            entry["interval"] = [float(v) for v in intervals[p.name]]
-        out[f"{role}.{key}"] = entry
-    return out
-
-
-def _materials_set(
-    data: MeasurementSet,
-    settings: CalibrationSettings,
-    base: InkPair,
-    params: Sequence[Parameter],
-    joint: JointCalibration,
-    after: Identifiability,
-    inputs: dict[str, Any],
-) -> MaterialSet:
-    fit = joint.chosen
-    model = base.model
-    active_name, passive_name = inputs["names"]
-    fitted = _fitted_entries(params, fit, after, data)
-    units = {
-        "youngs_modulus": "MPa",
-        "poisson_ratio": "1",
-        "density": "g/cm3",
-        "glass_transition": "C",
-    }
-
-    def singles(values: dict[str, Any]) -> dict[str, Any]:
-        out = {}
-        for key, (v, sd, prov, src) in values.items():
-            extra = {"sd": sd}
-            if key == "youngs_modulus":
-                extra["temperature"] = model.print_temperature
-            out[key] = _value(v, units[key], prov, src, **extra)
-        return out
-
-    def stated(given: float | None, default: float, unit: str, what: str) -> dict[str, Any]:
-        if given is None:
-            return _value(default, unit, "assumed", f"rotomorph calibrate's default {what}")
-        return _value(given, unit, "measured", f"stated by the lab (rotomorph calibrate {what})")
-
-    order_prov, order_src = inputs["order_provenance"]
-    speeds = [v for v, _ in inputs["order_points"]]
-    order: dict[str, Any] = {
-        "speed": speeds,
-        "speed_unit": "mm/s",
-        "value": [s for _, s in inputs["order_points"]],
-        "unit": "1",
-        "provenance": order_prov,
-        "source": order_src,
-    }
-    if inputs["order_sd"] is not None:
-        order["sd"] = list(inputs["order_sd"])
-    ratio = fitted["active.actuated_modulus_ratio"]
-    ratio.update(relative_to=passive_name, temperature=model.actuation_temperature)
-    active = {
-        "kind": "active",
-        "description": f"calibrated by rotomorph calibrate from {len(data.files)} table(s)",
-        **singles(inputs["active"]),
-        "modulus_law": "nematic-isotropic",
-        "actuated_modulus_ratio": ratio,
-        "transition_temperature": {**fitted["active.transition_temperature"], "unit": "C"},
-        "transition_width": {**fitted["active.transition_width"], "unit": "C"},
-        "hysteresis": _value(0.0, "C", "assumed", "no heating/cooling loop measured"),
-        "strain_law": "threshold",
-        "strain_gain": fitted["active.strain_gain"],
-        "strain_threshold": fitted["active.strain_threshold"],
-        "order_parameter": order,
-        "director_pitch": _value(
-            1.0,
-            "1",
-            "cited",
-            "kinematic director helix tan(phi) = omega* r/R (Raney et al., PNAS 115, 1198 (2018))",
-        ),
-    }
-    free_strain = {**fitted["passive.free_strain"], "temperature": model.actuation_temperature}
-    passive = {
-        "kind": "passive",
-        "description": f"calibrated by rotomorph calibrate from {len(data.files)} table(s)",
-        **singles(inputs["passive"]),
-        "modulus_law": "entropic",
-        "strain_law": "linear",
-        "free_strain": free_strain,
-    }
-    s = settings
-    doc = {
-        "schema_version": 1,
-        "name": settings.name,
-        "version": "1",
-        "description": "inks calibrated by rotomorph calibrate from the lab's measurement tables",
-        "strain_measure": model.strain_model.measure,
-        "conditions": {
-            "print_temperature": stated(s.print_temperature, 25.0, "C", "--print-temperature"),
-            "actuation_temperature": stated(
-                s.actuation_temperature, 175.0, "C", "--actuation-temperature"
-            ),
-        },
-        "nozzle": {
-            "filament_radius": stated(s.radius, 0.3, "mm", "--radius"),
-            "active_fraction": stated(s.active_fraction, 0.5, "1", "--active-fraction"),
-        },
-        "calibration": {
-            "method": "rotomorph calibrate: maximum a posteriori with Gaussian priors on both "
-            "modulus-ratio branches, weights 1/sd^2, Laplace covariance, leave-one-group-out",
-            "tables": [f"{PurePath(name).name} (sha256 {sha[:16]})" for name, sha in data.files],
-            "data_sha256": data.sha256,
-            "chosen_branch": fit.label.replace("model.modulus_ratio", "E_a/E_p"),
-            "branch_choice": joint.choice.replace("model.modulus_ratio", "E_a/E_p"),
-            "determined": [FILE_KEYS[n][1] for n in after.determined],
-            "at_prior": [FILE_KEYS[n][1] for n in after.at_prior],
-            "report": settings.report,
-            "parameters": [
-                f"{active_name if FILE_KEYS[p.name][0] == 'active' else passive_name}."
-                f"{FILE_KEYS[p.name][1]}"
-                for p in params
-            ],
-            "coordinates": ["ln" if p.log else "linear" for p in params],
-            "covariance": [
-                [float(x) for x in row] for row in 0.5 * (fit.covariance + fit.covariance.T)
-            ],
-        },
-        "inks": {active_name: active, passive_name: passive},
-    }
-    return materials_from_mapping(doc, "<rotomorph calibrate>")

@@ -360,8 +360,7 @@ class MaterialsDocument(_Model):
             ink = self.inks.get(ink_name)
             if ink is None or not isinstance(getattr(ink, value_key, None), Value):
                 raise ValueError(
-                    f"calibration.parameters: {key!r} names no value of this file's inks "
-                    "(ink.key)"
+                    f"calibration.parameters: {key!r} names no value of this file's inks (ink.key)"
                 )
         for name, ink in self.inks.items():
             if not INK_NAME.match(name):
