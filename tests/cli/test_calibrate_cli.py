@@ -118,3 +118,32 @@ def test_lattice_rows_are_predicted_by_a_contact_resolved_ramp(tmp_path) -> None
     assert "contact-resolved" in row.how
     skipped = calibrate_files(tables, tmp_path / "skip.toml", lattices=False, figures=False)
     assert skipped.validation[0].predicted is None
+
+
+@pytest.mark.parametrize("char", ["\x1b", "\u202e", "\x9b", "\u2028", "\x07"])
+def test_control_characters_in_a_table_never_reach_the_terminal(tmp_path, capsys, char) -> None:
+    bad = tmp_path / "bad.csv"
+    text = (INKS / "inks.csv").read_text("utf-8").replace("(polydomain)", f"(poly{char}[2J)", 1)
+    bad.write_text(text, encoding="utf-8")
+    assert main(["calibrate", str(bad), "-o", str(tmp_path / "x.toml")]) == 2
+    captured = capsys.readouterr()
+    assert captured.err.count("\n") == 1 and captured.out == "", captured
+    assert f"{bad}: row 6, column source: holds U+{ord(char):04X}" in captured.err
+    assert char not in captured.err and captured.err[:-1].isprintable()
+    assert not (tmp_path / "x.toml").exists()
+
+
+@pytest.mark.parametrize("char", ["\x1b", "\u202e", "\n", "\r"])
+def test_control_characters_in_a_materials_file_never_reach_the_terminal(
+    tmp_path, capsys, char
+) -> None:
+    bad = tmp_path / "bad.toml"
+    escaped = char.encode("unicode_escape").decode("ascii").replace("\\x", "\\u00")
+    text = (
+        (INKS / "inks.toml").read_text("utf-8").replace('source = "', f'source = "x{escaped}[2J', 1)
+    )
+    bad.write_text(text, encoding="utf-8")
+    assert main(["validate", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "must not hold control" in err, err
+    assert char not in err[:-1] and err[:-1].isprintable()

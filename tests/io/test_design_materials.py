@@ -105,6 +105,8 @@ def test_validate_names_the_file_and_checks_the_inks(lab, capsys) -> None:
         ('"inks"', "materials: inks: is not a file"),
         ('"bad.toml"', "materials: bad.toml: inks.rm257.youngs_modulus.unit: 'psi' is not a unit"),
         ("3", "materials: must be"),
+        ('"in\\u001b[2Jks.toml"', "materials: must not hold control"),
+        ('"in\\u202eks.toml"', "found U+202E (RIGHT-TO-LEFT OVERRIDE)"),
     ],
 )
 def test_a_bad_materials_entry_is_one_line(lab, capsys, entry, fragment) -> None:
@@ -115,6 +117,7 @@ def test_a_bad_materials_entry_is_one_line(lab, capsys, entry, fragment) -> None
     assert main(["validate", str(lab / "d.toml")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and fragment in err, err
+    assert err[:-1].isprintable(), err
 
 
 def test_hashes_follow_the_inks(lab) -> None:
@@ -261,3 +264,4 @@ def test_the_predict_command_gives_the_paper_twins_numbers_and_band(lab, capsys)
             ref = b["quantities"][key]
             assert q["value"] == pytest.approx(ref["value"], rel=1e-9, abs=1e-12), key
             assert q["sd_calibration"] == pytest.approx(ref["sd_calibration"], rel=1e-6), key
+

@@ -218,7 +218,8 @@ def test_bad_files_are_refused_in_one_line(tmp_path) -> None:
     bom = ("\ufeff" + HEADER + "\n" + "\n".join(GOOD) + "\n").encode("utf-8")
     assert len(parse_measurements([("bom.csv", bom)]).rows) == 4
     control = _parse  # a control character in a cell is refused, not printed
-    with pytest.raises(InvalidParameterError, match="control characters"):
+    shown = r"U\+001B \(ESC\) at position 0: '\\x1b\[31mred'; remove control"
+    with pytest.raises(InvalidParameterError, match=shown):
         control("janus_curvature,,0.25,mm/s,0.13,0.02,1/mm,\x1b[31mred", GOOD[1])
 
 

@@ -18,6 +18,7 @@ import math
 from pathlib import Path
 from typing import Any, Final
 
+from rotomorph._text import check_text
 from rotomorph.errors import MaterialError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.tomlfile import decode_toml_bytes, read_toml
@@ -91,7 +92,11 @@ def resolve_materials(entry: Any, base: str | Path | None) -> MaterialSet:
         raise MaterialError(
             "materials", "must be the path of a materials file (TOML, relative to the design)"
         )
-    shown = entry if entry.isprintable() else entry.encode("unicode_escape").decode("ascii")
+    try:
+        check_text(entry)
+    except ValueError as err:
+        raise MaterialError("materials", str(err)) from None
+    shown = entry
     path = Path(base or ".") / entry
     if not path.is_file():
         where = "no such file" if not path.exists() else "is not a file"

@@ -35,6 +35,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Final
 
+from rotomorph._text import describe_character, terminal_safe, unsafe_characters
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.lab_tables import (
     CONDITION_KEYS,
@@ -66,7 +67,7 @@ _PART = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_*]*)\s*=\s*(.*?)\s*$")
 def _shown(text: str) -> str:
     """``text`` safe for a one-line message (control characters escaped, shortened)."""
     text = text if len(text) <= 60 else text[:57] + "..."
-    return repr(text) if text.isprintable() else repr(text.encode("unicode_escape").decode())
+    return repr(text) if text.isprintable() else f"'{terminal_safe(text)}'"
 
 
 class _Row:
@@ -184,8 +185,13 @@ def _measurement(at: _Row, cells: dict[str, str]) -> Measurement:
         text = cells[column]
         if len(text) > MAX_TEXT:
             raise at.error(column, f"is {len(text)} characters; at most {MAX_TEXT}")
-        if any(not (c.isprintable() or c == "\t") for c in text):
-            raise at.error(column, f"holds control characters: {_shown(text)}")
+        bad = unsafe_characters(text)
+        if bad:
+            raise at.error(
+                column,
+                f"holds {describe_character(bad[0][1])} at position {bad[0][0]}: "
+                f"{_shown(text)}; remove control and bidirectional-formatting characters",
+            )
     name = cells["quantity"].strip()
     q = QUANTITIES.get(name)
     if q is None:

@@ -21,10 +21,25 @@ from __future__ import annotations
 import re
 from typing import Annotated, Any, Final, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
+from rotomorph._text import check_text
 from rotomorph.errors import InvalidParameterError, MaterialError
-from rotomorph.materials.units import CANONICAL, spread_to_canonical, to_canonical
+from rotomorph.materials.units import to_canonical
+from rotomorph.materials.value_ranges import (
+    DIMENSION,
+    SPEED_RANGE,
+    check_range,
+    convert_value,
+)
 
 __all__ = [
     "PROVENANCES",
@@ -47,14 +62,27 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
-Text = Annotated[str, Field(max_length=2000, pattern=r"^[^\x00-\x08\x0b-\x1f\x7f]*$")]
+def _one_line(text: str) -> str:
+    return check_text(text)
+
+
+def _free_text(text: str) -> str:
+    return check_text(text, newlines=True)
+
+
+#: Text from the file: shown on terminals, in reports and in G-code comments, so no control,
+#: line-separator or bidirectional-formatting character (:func:`rotomorph._text.check_text`).
+Text = Annotated[str, Field(max_length=2000), AfterValidator(_one_line)]
+#: A ``description`` may keep newlines and tabs.
+FreeText = Annotated[str, Field(max_length=2000), AfterValidator(_free_text)]
+Word = Annotated[str, Field(max_length=64), AfterValidator(_one_line)]
 
 
 class Value(_Model):
     """One value with its unit and where it comes from (see module docstring)."""
 
     value: float
-    unit: str = Field(max_length=20)
+    unit: Annotated[str, Field(max_length=20), AfterValidator(_one_line)]
     provenance: Provenance
     source: Text = Field(min_length=1)
     sd: float | None = Field(None, ge=0)
@@ -66,70 +94,24 @@ class Ratio(Value):
     """The active ink's modulus at full actuation relative to a passive ink's at the same
     temperature."""
 
-    relative_to: str = Field(min_length=1, max_length=64)
+    relative_to: Annotated[str, Field(min_length=1, max_length=64), AfterValidator(_one_line)]
 
 
 class Curve(_Model):
     """The order parameter S measured at print speeds (interpolated linearly in ln v)."""
 
     speed: list[float] = Field(min_length=2, max_length=1000)
-    speed_unit: str = "mm/s"
+    speed_unit: Annotated[str, Field(max_length=20), AfterValidator(_one_line)] = "mm/s"
     value: list[float] = Field(min_length=2, max_length=1000)
     sd: list[float] | None = None
-    unit: str = "1"
+    unit: Annotated[str, Field(max_length=20), AfterValidator(_one_line)] = "1"
     provenance: Provenance
     source: Text = Field(min_length=1)
 
 
-#: Dimension (units module) of each value key; ``"interval"`` values follow the same unit.
-DIMENSION: Final[dict[str, str]] = {
-    "youngs_modulus": "modulus",
-    "actuated_modulus_ratio": "ratio",
-    "poisson_ratio": "ratio",
-    "glass_transition": "temperature",
-    "transition_temperature": "temperature",
-    "transition_width": "temperature_difference",
-    "hysteresis": "temperature_difference",
-    "density": "density",
-    "free_length": "ratio",
-    "free_strain": "ratio",
-    "strain_gain": "ratio",
-    "strain_threshold": "ratio",
-    "order_scale": "ratio",
-    "director_pitch": "ratio",
-    "print_temperature": "temperature",
-    "actuation_temperature": "temperature",
-    "outlet_diameter": "length",
-    "filament_radius": "length",
-    "active_fraction": "ratio",
-}
-
-
-def _convert(key: str, v: Value) -> Value:
-    """``v`` in the canonical unit of ``key``'s dimension (units module)."""
-    dim = DIMENSION[key]
-    if dim == "temperature_difference":  # a width: K and °C differ by scale 1 only
-        base = {"C": 1.0, "°C": 1.0, "degC": 1.0, "K": 1.0}
-        if v.unit.strip() not in base:
-            raise ValueError(
-                f"{key}.unit: {v.unit!r} is not a temperature difference; use 'C' or 'K'"
-            )
-        return v.model_copy(update={"unit": "C"})
-    try:
-        value = to_canonical(dim, v.value, v.unit)
-        sd = None if v.sd is None else spread_to_canonical(dim, v.sd, v.unit)
-        interval = (
-            None if v.interval is None else [to_canonical(dim, x, v.unit) for x in v.interval]
-        )
-    except InvalidParameterError as err:
-        raise ValueError(f"{key}.unit: {str(err).split(': ', 1)[-1]}") from None
-    return v.model_copy(
-        update={"value": value, "sd": sd, "interval": interval, "unit": CANONICAL[dim]}
-    )
-
-
 class _Converting(_Model):
-    """A table of values converted to canonical units after validation."""
+    """A table of values converted to canonical units after validation, each checked
+    against its physical range (:data:`~rotomorph.materials.value_ranges.RANGE`)."""
 
     @model_validator(mode="after")
     def _units(self) -> _Converting:
@@ -137,7 +119,8 @@ class _Converting(_Model):
         for key in type(self).model_fields:
             v = getattr(self, key)
             if isinstance(v, Value) and key in DIMENSION:
-                updates[key] = _convert(key, v)
+                updates[key] = convert_value(key, v)
+                check_range(key, updates[key])
         for key, v in updates.items():
             object.__setattr__(self, key, v)
         return self
@@ -179,7 +162,7 @@ class NozzleGeometry(_Converting):
 
 
 class _Ink(_Converting):
-    description: Text = ""
+    description: FreeText = ""
     youngs_modulus: Value
     poisson_ratio: Value
     glass_transition: Value | None = None
@@ -270,6 +253,11 @@ class ActiveInk(_Ink):
             raise ValueError(f"unit: {c.unit!r} is not the unit of an order parameter; use '1'")
         if any(s <= 0 for s in speeds) or len(set(speeds)) != len(speeds):
             raise ValueError("speed: must hold distinct print speeds > 0")
+        if not SPEED_RANGE[0] <= min(speeds) <= max(speeds) <= SPEED_RANGE[1]:
+            raise ValueError(
+                f"speed: print speeds must lie in [{SPEED_RANGE[0]:g}, {SPEED_RANGE[1]:g}] mm/s; "
+                f"got {min(speeds):g}-{max(speeds):g}"
+            )
         if any(not 0.0 <= s < 1.0 for s in c.value):
             raise ValueError("value: must hold order parameters in [0, 1)")
         if c.sd is not None and any(s < 0 for s in c.sd):
@@ -307,12 +295,12 @@ class CalibrationRecord(_Model):
     """
 
     method: Text
-    tables: list[Text] = Field(default_factory=list)
+    tables: list[Text] = Field(default_factory=list, max_length=1000)
     data_sha256: str = Field(pattern=r"^[0-9a-f]{64}$")
     chosen_branch: Text = ""
     branch_choice: Text = ""
-    determined: list[str] = Field(default_factory=list)
-    at_prior: list[str] = Field(default_factory=list)
+    determined: list[Word] = Field(default_factory=list, max_length=100)
+    at_prior: list[Word] = Field(default_factory=list, max_length=100)
     report: Text = ""
     parameters: list[str] = Field(default_factory=list, max_length=20)
     coordinates: list[Literal["ln", "linear"]] = Field(default_factory=list, max_length=20)
@@ -346,7 +334,7 @@ class MaterialsDocument(_Model):
     schema_version: Literal[1] = Field(SCHEMA_VERSION, description="format version; write 1")
     name: str = Field(min_length=1, max_length=100, pattern=INK_NAME.pattern)
     version: str = Field("1", max_length=40, pattern=r"^[A-Za-z0-9_.+-]+$")
-    description: Text = ""
+    description: FreeText = ""
     strain_measure: Literal["hencky", "engineering"] = "hencky"
     conditions: Conditions
     nozzle: NozzleGeometry
