@@ -265,3 +265,22 @@ def test_the_predict_command_gives_the_paper_twins_numbers_and_band(lab, capsys)
             assert q["value"] == pytest.approx(ref["value"], rel=1e-9, abs=1e-12), key
             assert q["sd_calibration"] == pytest.approx(ref["sd_calibration"], rel=1e-6), key
 
+
+def test_the_predict_command_says_which_file_and_band(lab, capsys) -> None:
+    sha = load_materials(lab / "inks" / "lab.toml").sha256
+    assert main(["predict", str(lab / "design.toml")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].startswith(f"materials 'lab-inks' version 1 (sha256 {sha[:12]}): ± is ")
+    assert "posterior covariance of rm257.actuated_modulus_ratio" in lines[1]
+    assert all(" ± " in line for line in lines[2:]), lines
+    doc = lab_document()
+    del doc["calibration"]  # a file without a stored calibration: values, no band
+    save_materials(materials_from_mapping(doc), lab / "inks" / "lab.toml")
+    assert main(["predict", str(lab / "design.toml"), "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["band"].startswith("none: the materials file stores no calibration covariance")
+    for filament in record["filaments"]:
+        assert all(q["sd_calibration"] is None for q in filament["quantities"].values())
+    assert main(["predict", str(lab / "design.toml")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "± is none" in lines[1] and not any(" ± " in line for line in lines[2:]), lines

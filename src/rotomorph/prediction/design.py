@@ -49,8 +49,7 @@ class DesignPrediction:
         return {
             "design": self.name,
             "temperature_C": self.temperature,
-            "band": "calibration only (posterior of the joint filament calibration, as the "
-            "paper report); inputs the paper does not give are not in it",
+            "band": _PAPER_BAND if self.materials is None else self.materials["band"],
             "calibrated_range": self.range_record or calibrated_range().record(),
             "materials": self.materials,
             "extrapolated": self.extrapolated,
@@ -59,11 +58,37 @@ class DesignPrediction:
         }
 
     def lines(self) -> list[str]:
-        """Lines for a terminal."""
-        out = [f.line() for f in self.filaments]
+        """Lines for a terminal (first, with a materials file, which file and which band)."""
+        out = []
+        if self.materials is not None:
+            m = self.materials
+            out.append(
+                f"materials '{m['name']}' version {m['version']} (sha256 {m['sha256'][:12]}): "
+                f"± is {m['band']}"
+            )
+        out += [f.line() for f in self.filaments]
         if self.lattice is not None:
             out.append(self.lattice.line())
         return out
+
+
+_PAPER_BAND = (
+    "calibration only (posterior of the joint filament calibration, as the paper report); "
+    "inputs the paper does not give are not in it"
+)
+
+
+def _file_band(inks: Any) -> str:
+    """What a materials file's band is: its stored calibration covariance, or none."""
+    cal = inks.document.calibration
+    if cal is None or not cal.parameters:
+        return "none: the materials file stores no calibration covariance (values without a band)"
+    fitted = ", ".join(cal.parameters)
+    return (
+        f"calibration only (the posterior covariance of {fitted} stored in the file by its "
+        f"calibration, data sha256 {cal.data_sha256[:12]}); inputs the file does not fit are "
+        "not in it"
+    )
 
 
 def predict_design(
@@ -93,5 +118,5 @@ def predict_design(
         return DesignPrediction(design.name, float(temperature), tuple(filaments), lattice)
     with calibration_of(inks, inks.names("active")[0], inks.names("passive")[0]):
         rng = calibrated_range().record()
-    record = {**inks.record(), "band": "the materials file's stored posterior covariance"}
+    record = {**inks.record(), "band": _file_band(inks)}
     return DesignPrediction(design.name, float(temperature), tuple(filaments), lattice, record, rng)
