@@ -627,6 +627,9 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     with _phases():
         run = calibrate_files(tables, out, settings, lattices=not args.no_lattices)
     _print(run.summary_line())
+    _print("what the tables determine (at the fit):")
+    for line in run.identifiability_lines():
+        _print(f"  {line}")
     return EXIT_OK
 
 

@@ -3,7 +3,10 @@ that names the file prints; bad input exits 2 with one line."""
 
 from __future__ import annotations
 
+import io
 import json
+import logging
+from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import pytest
@@ -16,11 +19,37 @@ INKS = ROOT / "examples" / "inks"
 TABLES = [str(INKS / n) for n in ("filaments.csv", "inks.csv", "sinusoids.csv")]
 
 
+#: What the module's calibration printed (``out``: stdout, ``err``: its progress with -v).
+PRINTED: dict[str, str] = {}
+
+
 @pytest.fixture(scope="module")
 def calibrated(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("cal") / "lab" / "inks.toml"
-    assert main(["calibrate", *TABLES, "-o", str(out)]) == 0
+    stdout, stderr = io.StringIO(), io.StringIO()
+    library = logging.getLogger("rotomorph")  # as -v does (pytest's handlers keep basicConfig off)
+    level = library.level
+    library.setLevel(logging.INFO)
+    try:
+        with redirect_stdout(stdout), redirect_stderr(stderr):
+            assert main(["-v", "calibrate", *TABLES, "-o", str(out)]) == 0
+    finally:
+        library.setLevel(level)
+    PRINTED.update(out=stdout.getvalue(), err=stderr.getvalue())
     return out
+
+
+def test_says_what_the_tables_determine_before_and_after_the_fit(calibrated) -> None:
+    out, err = PRINTED["out"].splitlines(), PRINTED["err"]
+    assert out[0].startswith(f"wrote {calibrated} and ") and out[1].startswith("what the tables")
+    said = {line.strip().split(":")[0]: line for line in out[2:]}
+    assert "stays at its prior" in said["T_NI"] and "free_length of the active ink" in said["T_NI"]
+    assert "stays at its prior" in said["transition width"], said
+    for label in ("strain-law gain", "strain-law threshold S0", "E_a/E_p at actuation"):
+        assert said[label].strip().startswith(f"{label}: determined by "), said[label]
+    assert out[-1].strip().startswith("singular values of the prior-scaled sensitivities")
+    before = err.index("what the tables determine, before fitting:")
+    assert before < err.index("fitting (both branches") and "T_NI: stays at its prior" in err
 
 
 def test_writes_the_file_report_and_figures(calibrated, capsys) -> None:

@@ -19,6 +19,7 @@ and after it, the leave-one-group-out predictions and the :class:`MaterialSet` t
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Final
@@ -38,6 +39,9 @@ from rotomorph.materials.material import Material
 from rotomorph.materials.natural import FilamentModel
 from rotomorph.materials.parameter_set import MaterialSet
 from rotomorph.materials.process import EmpiricalThreshold, order_parameter
+
+#: Phase messages (the command line shows them on a terminal or with --verbose).
+progress = logging.getLogger("rotomorph.progress")
 
 __all__ = [
     "ESSENTIAL",
@@ -321,6 +325,10 @@ def calibrate_tables(
         where="prior mean, E_a/E_p = 10 (before fitting)",
     )  # fmt: skip
     _refuse_degenerate(before, rows)
+    progress.info("what the tables determine, before fitting:")
+    for line in before.lines():
+        progress.info("  %s", line)
+    progress.info("fitting (both branches of the bilayer symmetry, then leave-one-group-out)")
     joint = joint_calibrate(
         groups,
         params,

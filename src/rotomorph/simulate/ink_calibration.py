@@ -81,6 +81,12 @@ class CalibrationRun:
     figures: tuple[Path, ...] = ()
     curves: dict[str, Any] = field(default_factory=dict)
 
+    def identifiability_lines(self) -> list[str]:
+        """What the tables determine at the fitted optimum, in words: one line per parameter
+        (determined by which tables, or at its prior and which measurement would pin it down),
+        then the singular values."""
+        return self.calibration.after.lines()
+
     def summary_line(self) -> str:
         """One line for the terminal."""
         cal = self.calibration
