@@ -9,10 +9,17 @@ import pytest
 
 @pytest.fixture(scope="session", autouse=True)
 def _result_cache(tmp_path_factory: pytest.TempPathFactory) -> None:
-    """Keep rotomorph's disk cache of report results inside the test session (shared by the
-    tests of one session, never read from or written to the user's ~/.cache)."""
+    """Keep rotomorph's disk cache of report results inside the test run: shared by every
+    test of the run, the xdist workers' included (the run's common temporary folder; the
+    cache computes an entry once however many processes ask for it at the same time), never
+    read from or written to the user's ~/.cache."""
     if "ROTOMORPH_CACHE_DIR" not in os.environ:
-        os.environ["ROTOMORPH_CACHE_DIR"] = str(tmp_path_factory.mktemp("rotomorph-cache"))
+        base = tmp_path_factory.getbasetemp()
+        if os.environ.get("PYTEST_XDIST_WORKER"):  # base is this worker's: popen-gw0, ...
+            base = base.parent
+        folder = base / "rotomorph-cache"
+        folder.mkdir(exist_ok=True)
+        os.environ["ROTOMORPH_CACHE_DIR"] = str(folder)
 
 
 #: Set to 1 by ``.ci/run``: a referee tool that is missing fails the run instead of skipping.

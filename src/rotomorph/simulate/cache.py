@@ -5,18 +5,22 @@ source and data file of the installed ``rotomorph`` package, so any change of co
 recomputes it; nothing stale can be served. The folder is ``$ROTOMORPH_CACHE_DIR`` or
 ``~/.cache/rotomorph``; ``ROTOMORPH_CACHE_DIR=off`` disables caching. Files are written
 atomically (:func:`rotomorph.io.atomic.atomic_write_bytes`); an unreadable entry is recomputed.
+Processes sharing the folder (two runs at once, a test suite's workers) compute an entry once:
+while one computes it, the others wait on its lock file (``fcntl.flock``, released by the
+system if that process dies) and then read it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import logging
 import os
 import pickle
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import rotomorph
 from rotomorph.io.atomic import atomic_write_bytes
@@ -65,12 +69,51 @@ def disk_cached(name: str, key: str, compute: Callable[[], T]) -> T:
         return compute()
     digest = hashlib.sha256(f"{name}\0{key}\0{source_digest()}".encode()).hexdigest()[:32]
     path = folder / f"{name}-{digest}.pickle"
-    if path.is_file():
-        try:
-            with path.open("rb") as fh:
-                return pickle.load(fh)  # type: ignore[no-any-return]
-        except Exception as err:
-            logger.warning("cache entry %s unreadable (%s); recomputing", path, err)
+    found = _read(path)
+    if found is not None:
+        return found[0]
+    with _entry_lock(path):
+        found = _read(path)  # computed by another process while this one waited
+        if found is not None:
+            return found[0]
+        return _compute_and_store(path, compute)
+
+
+def _read(path: Path) -> tuple[Any] | None:
+    """``(value,)`` of a readable cache entry, else ``None``."""
+    if not path.is_file():
+        return None
+    try:
+        with path.open("rb") as fh:
+            return (pickle.load(fh),)
+    except Exception as err:
+        logger.warning("cache entry %s unreadable (%s); recomputing", path, err)
+        return None
+
+
+@contextlib.contextmanager
+def _entry_lock(path: Path) -> Iterator[None]:
+    """Hold ``path``'s lock file while its entry is computed (no lock where the folder cannot
+    be written or the system has no ``fcntl``: the entry is then just computed)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows
+        yield
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = path.with_suffix(".lock").open("a+b")
+    except OSError as err:
+        logger.debug("no lock for cache entry %s: %s", path, err)
+        yield
+        return
+    with fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        yield
+
+
+def _compute_and_store(path: Path, compute: Callable[[], T]) -> T:
+    folder = path.parent
     result = compute()
     try:
         folder.mkdir(parents=True, exist_ok=True)
