@@ -29,7 +29,7 @@ from rotomorph.errors import (
     RotomorphError,
 )
 
-__version__ = "0.1.0"
+__version__ = "0.3.0"
 
 #: Public name -> module that defines it (imported on first access).
 _LAZY = {

@@ -1,5 +1,5 @@
 ; rotomorph G-code (rotational multimaterial printing)
-; tool: rotomorph 0.1.0
+; tool: rotomorph 0.3.0
 ; design-sha256: 954abf4bacbdf3926504d0ad0b1acd518d70c069f1513a299f2d8958b17f0417
 ; machine: golden, built-in default (no machine profile given: its envelope and limits are assumptions; pass --machine FILE for your printer)
 ; controller: a3200
