@@ -86,3 +86,28 @@ def test_report_and_figures(report):
         assert path.stat().st_size > 10_000, path
         img = np.asarray(Image.open(path).convert("L"), dtype=float)
         assert img.std() > 5.0, f"{fig} looks blank"
+
+
+@pytest.mark.slow
+def test_rerun_into_its_own_folder(report, tmp_path, capsys, monkeypatch):
+    """A second ``paper`` into its own output folder replaces it (no --force), with progress
+    lines that count computations; a folder holding anything else is refused, naming it."""
+    import shutil
+
+    import rotomorph._progress as progress_module
+
+    monkeypatch.setattr(progress_module, "INTERVAL", 0.05)
+    monkeypatch.setattr(progress_module, "FIRST_LINE", 0.01)
+    out = tmp_path / "out"
+    shutil.copytree(report, out)
+    capsys.readouterr()
+    assert main(["paper", "-o", str(out), "--quick", "--allow-unconverged"]) == EXIT_OK
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.startswith("rotomorph: paper: ")]
+    assert lines and re.search(r"paper: \d+ of \d+ computations", lines[-1]), err
+    assert (out / "report.md").is_file() and (out / "rotomorph-run.json").is_file()
+    (out / "notes.txt").write_text("mine", encoding="utf-8")
+    assert main(["paper", "-o", str(out), "--quick"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "notes.txt" in err and "--force" in err and "\n" not in err
+    assert (out / "notes.txt").read_text(encoding="utf-8") == "mine"
