@@ -11,7 +11,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1] / "src" / "rotomorph"
 LAYERS = [
-    {"", "__init__", "errors", "_typing", "_display", "_text", "geometry"},
+    {"", "__init__", "errors", "_typing", "_display", "_progress", "_text", "geometry"},
     {"design"},
     {"materials"},
     {"rod"},

@@ -67,11 +67,15 @@ class _Parser(argparse.ArgumentParser):
 # ----------------------------------------------------------------------------- helpers
 
 
-def _progress(total: int, desc: str) -> Any:
-    """A tqdm bar on stderr, silent when stderr is not a terminal."""
-    from tqdm import tqdm
+def _display(args: argparse.Namespace, desc: str, total: int | None, unit: str) -> Any:
+    """Progress of a command (:mod:`rotomorph._progress`): a bar on a terminal, a line every
+    10 s elsewhere, the library's ``rotomorph.progress`` messages as its note (each as a line
+    with --verbose); nothing with --quiet."""
+    from rotomorph._progress import progress_display
 
-    return tqdm(total=total, desc=desc, unit="step", disable=not sys.stderr.isatty(), leave=False)
+    return progress_display(
+        desc, total, unit, verbose=args.verbose, quiet=getattr(args, "quiet", False)
+    )
 
 
 class _SafeFormatter(logging.Formatter):
@@ -84,29 +88,9 @@ class _SafeFormatter(logging.Formatter):
 
 
 def _show_progress() -> bool:
-    """Progress (bars, phases, the compile note) goes to a terminal or with --verbose."""
+    """The compile note is said at once on a terminal or with --verbose (elsewhere the
+    progress lines say it when it takes long)."""
     return sys.stderr.isatty() or logging.getLogger("rotomorph").isEnabledFor(logging.INFO)
-
-
-@contextlib.contextmanager
-def _phases() -> Iterator[None]:
-    """Show the library's phase messages (``rotomorph.progress``) while a command runs."""
-    log = logging.getLogger("rotomorph.progress")
-    if not _show_progress():
-        yield
-        return
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(_SafeFormatter("rotomorph: %(message)s"))
-    old = (log.level, log.propagate)
-    log.addHandler(handler)
-    log.setLevel(logging.INFO)
-    log.propagate = False
-    try:
-        yield
-    finally:
-        log.removeHandler(handler)
-        log.setLevel(old[0])
-        log.propagate = old[1]
 
 
 #: Commands that run compiled kernels (they say so at once when the kernel cache is cold).
@@ -114,28 +98,32 @@ _COMPILING = ("simulate", "paper")
 
 
 def _announce_compiling(args: argparse.Namespace) -> None:
-    """Before a compiling command imports anything heavy (about a second after start): say
-    "compiling kernels (first run only)" when the kernel cache is cold; remember the answer
-    on ``args`` for :func:`_compiling_note`."""
+    """Before a compiling command imports anything heavy (about a second after start): find
+    out whether the kernel cache is cold, remember it on ``args`` for
+    :func:`_compiling_note`, and on a terminal or with --verbose say "compiling kernels
+    (first run only)" at once."""
     args.kernels_cold = False
-    if args.command not in _COMPILING or not _show_progress():
+    if args.command not in _COMPILING or getattr(args, "quiet", False):
         return
     from rotomorph.simulate.kernel_cache import kernels_cached
 
     if not kernels_cached():
         args.kernels_cold = True
-        sys.stderr.write(
-            "rotomorph: compiling kernels (first run only; about 20-40 s of CPU, cached after)\n"
-        )
-        sys.stderr.flush()
+        if _show_progress():
+            sys.stderr.write(
+                "rotomorph: compiling kernels (first run only; about 20-40 s of CPU, cached "
+                "after)\n"
+            )
+            sys.stderr.flush()
 
 
 @contextlib.contextmanager
 def _compiling_note(args: argparse.Namespace) -> Iterator[None]:
-    """While a command runs on a cold kernel cache (:func:`_announce_compiling`): a bar of
-    compiled kernels on a terminal, a line every 10 s in a log, until the core kernels are
-    cached or the command ends."""
-    if not getattr(args, "kernels_cold", False) or not _show_progress():
+    """While a command runs on a cold kernel cache (:func:`_announce_compiling`): how many
+    kernels are ready, as a ``rotomorph.progress`` message (the note of the command's
+    progress display: its bar on a terminal, its lines elsewhere) when the count changes, at
+    most every 2 s, until the core kernels are cached or the command ends."""
+    if not getattr(args, "kernels_cold", False):
         yield
         return
     import threading
@@ -148,22 +136,16 @@ def _compiling_note(args: argparse.Namespace) -> Iterator[None]:
     log = logging.getLogger("rotomorph.progress")
 
     def watch() -> None:
-        from tqdm import tqdm
-
         total = len(dispatchers())
-        tty = sys.stderr.isatty()  # a live bar only on a terminal (no \r in logs)
-        with tqdm(
-            total=total, desc="compiling kernels", unit="kernel", leave=False, disable=not tty
-        ) as bar:
-            next_line = 10.0
-            while not done.wait(0.5):
-                if kernels_cached():
-                    log.info("kernels compiled after %.0f s", time.perf_counter() - t0)
-                    return
-                bar.update(compiled_count() - bar.n)
-                if not tty and time.perf_counter() - t0 >= next_line:
-                    log.info("compiling kernels: %d of %d ready", compiled_count(), total)
-                    next_line += 10.0
+        said, last = -1, t0
+        while not done.wait(0.5):
+            if kernels_cached():
+                log.info("kernels compiled after %.0f s", time.perf_counter() - t0)
+                return
+            count, now = compiled_count(), time.perf_counter()
+            if count != said and now - last >= 2.0:
+                log.info("compiling kernels: %d of %d ready", count, total)
+                said, last = count, now
 
     thread = threading.Thread(target=watch, daemon=True)
     thread.start()
@@ -193,12 +175,17 @@ def _load_design(path: str) -> Any:
 
 
 @contextlib.contextmanager
-def _output_folder(path: str, *, force: bool, inputs: Sequence[Path] = ()) -> Iterator[Path]:
+def _output_folder(
+    path: str, *, force: bool, inputs: Sequence[Path] = (), previous: str | None = None
+) -> Iterator[Path]:
     """Yield a temporary folder next to ``path``; swap it onto ``path`` on success.
 
     On error (or SIGTERM) the temporary folder is removed and ``path`` is untouched
     (:func:`rotomorph.io.atomic.atomic_folder`). A folder that holds the current folder or one
-    of the ``inputs`` (the design file) is never replaced, ``--force`` or not.
+    of the ``inputs`` (the design file) is never replaced, ``--force`` or not. A non-empty
+    folder is replaced only with ``force``, or, for a command ``previous`` that records its
+    output (:mod:`rotomorph.io.run_manifest`), when it holds exactly that command's previous
+    run.
     """
     from rotomorph.io.atomic import atomic_folder
 
@@ -221,7 +208,14 @@ def _output_folder(path: str, *, force: bool, inputs: Sequence[Path] = ()) -> It
                     "it: give a new folder"
                 )
     if target.is_dir() and any(target.iterdir()) and not force:
-        raise UsageError(f"-o/--output: {path}: folder is not empty; use --force to replace it")
+        why = "folder is not empty"
+        if previous is not None:
+            from rotomorph.io.run_manifest import previous_run
+
+            reason = previous_run(target, previous)
+            why = "" if reason is None else f"folder is not empty: {reason}"
+        if why:
+            raise UsageError(f"-o/--output: {path}: {why}; use --force to replace it")
     _check_writable(target, create_parent=True)
     with atomic_folder(target) as tmp:
         yield tmp
@@ -246,6 +240,31 @@ def _print(text: str) -> None:
     from rotomorph._text import terminal_safe
 
     sys.stdout.write(terminal_safe(text, newlines=True) + "\n")
+
+
+#: How to get MP4 movies (said where a GIF is written instead).
+MP4_HINT = (
+    "for MP4 install ffmpeg (e.g. apt install ffmpeg, conda install -c conda-forge ffmpeg or "
+    "brew install ffmpeg) and redraw with rotomorph plot RUN/results.h5 -o RUN/figures"
+)
+
+
+def _say_movie(args: argparse.Namespace, shown: Any = None) -> None:
+    """Say in one line, before the figures are drawn, that the movie is a GIF (no ffmpeg)."""
+    if args.no_movie:
+        return
+    from rotomorph.plot.animate import ffmpeg_available
+
+    if ffmpeg_available():
+        return
+    line = (
+        "rotomorph: note: no ffmpeg found: the movie is figures/morphing.gif instead of "
+        f"figures/morphing.mp4 ({MP4_HINT})"
+    )
+    if shown is not None and shown.enabled:
+        shown.write(line)
+    else:
+        sys.stderr.write(line + "\n")
 
 
 # ----------------------------------------------------------------------------- commands
@@ -481,22 +500,32 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         except InvalidParameterError as err:
             raise UsageError(f"--spacing: {err}") from None
     output = _output_folder(args.output, force=args.force, inputs=[Path(args.design)])
-    with output as tmp, _phases(), _compiling_note(args):
-        with _progress(step_count(design, args.steps), "simulate") as bar:
-            sim = simulate_design(
-                design,
-                steps=args.steps,
-                start_temperature=args.start_temperature,
-                temperature=args.temperature,
-                spacing=args.spacing,
-                actuation=args.actuation,
-                model=options["model"],
-                progress=bar.update,
-            )
+    unit = "ramp steps" if design.lattice is not None else "steps"
+    with (
+        output as tmp,
+        _display(args, "simulate", step_count(design, args.steps), unit) as shown,
+        _compiling_note(args),
+    ):
+        sim = simulate_design(
+            design,
+            steps=args.steps,
+            start_temperature=args.start_temperature,
+            temperature=args.temperature,
+            spacing=args.spacing,
+            actuation=args.actuation,
+            model=options["model"],
+            progress=shown.advance,
+        )
         logging.getLogger("rotomorph.progress").info("describing the run (frames, twist, flags)")
         results = describe_run(sim)
-        write_run_results(results, tmp, movie=not args.no_movie)
-    _print(f"wrote {args.output}: {run_line(results)}")
+        _say_movie(args, shown)
+        written = write_run_results(results, tmp, movie=not args.no_movie)
+    movie = next(
+        (p.name for p in written if p.stem == "morphing" and p.parent.name == "figures"), ""
+    )
+    _print(
+        f"wrote {args.output}: {run_line(results)}" + (f"; movie figures/{movie}" if movie else "")
+    )
     return EXIT_OK
 
 
@@ -526,8 +555,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"-o/--output: {args.output}: exists and is not a folder")
     _check_writable(out / "shapes.png" if out.is_dir() else out, create_parent=True)
+    _say_movie(args)
     paths = plot_run(results, out, movie=not args.no_movie)
-    _print(f"wrote {len(paths)} file(s) to {args.output}")
+    movie = [p.name for p in paths if p.stem == "morphing"]
+    _print(
+        f"wrote {len(paths)} file(s) to {args.output}" + (f" (movie: {movie[0]})" if movie else "")
+    )
     return EXIT_OK
 
 
@@ -549,16 +582,21 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
+    from rotomorph.io.run_manifest import write_manifest
     from rotomorph.simulate.report import paper_report
 
-    with _output_folder(args.output, force=args.force) as tmp, _phases(), _compiling_note(args):
-        with _progress(0, "paper") as bar:
+    with (
+        _output_folder(args.output, force=args.force, previous="paper") as tmp,
+        _display(args, "paper", None, "computations") as shown,
+        _compiling_note(args),
+    ):
 
-            def progress(done: int, total: int) -> None:
-                bar.total = total
-                bar.update(done)
+        def progress(done: int, total: int) -> None:
+            shown.set_total(total)
+            shown.advance(done)
 
-            report = paper_report(tmp, quick=args.quick, progress=progress)
+        report = paper_report(tmp, quick=args.quick, progress=progress)
+        write_manifest(tmp, "paper")
     _print(
         f"wrote {args.output}/report.md and summary.json: {len(report.rows)} rows "
         f"in {report.wall_time:.0f} s"
@@ -583,8 +621,13 @@ def _cmd_inverse(args: argparse.Namespace) -> int:
     if out.exists() and not args.force:
         raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
     _check_writable(out, create_parent=True, inputs=[target])
-    with _progress(0, "inverse") as bar:
-        text = inverse_file(target, out, progress=lambda it, j: bar.update(1))
+    with _display(args, "inverse", None, "iterations") as shown:
+
+        def progress(iteration: int, objective: float) -> None:
+            shown.set_done(iteration)
+            shown.set_note(f"objective {objective:.4g}")
+
+        text = inverse_file(target, out, progress=progress)
     _print(text)
     return EXIT_OK
 
@@ -645,6 +688,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=rotomorph.__version__)
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    parser.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress bar or progress lines"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     p = sub.add_parser("validate", help="check a design file", description="Check a design file.")

@@ -67,6 +67,7 @@ __all__ = [
     "ThermalActuation",
     "default_stiffness",
     "get_actuation",
+    "ramp_value_text",
 ]
 
 ACTUATIONS = ("literal", "swapped", "radius", "additive", "thermal", "program")
@@ -542,6 +543,18 @@ def default_stiffness(
     physical = isinstance(actuation, (ProgramActuation, ThermalActuation))
     chosen: Stiffness = stiffness or ("janus" if physical else "paper")
     return chosen, fm if chosen == "janus" else None
+
+
+#: Actuations whose ramp parameter is the temperature (°C); the others ramp a number x.
+TEMPERATURE_ACTUATIONS = ("thermal", "program")
+
+
+def ramp_value_text(actuation: Actuation, value: float) -> str:
+    """A ramp parameter with its unit, for messages: ``"131.2 °C"`` for the temperature-driven
+    actuations (:data:`TEMPERATURE_ACTUATIONS`), ``"x = 0.35"`` for the others."""
+    if actuation.name in TEMPERATURE_ACTUATIONS:
+        return f"{value:.1f} °C"
+    return f"x = {value:.4g}"
 
 
 def get_actuation(actuation: str | Actuation) -> Actuation:

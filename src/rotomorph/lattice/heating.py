@@ -25,7 +25,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -44,6 +44,7 @@ from rotomorph.lattice.actuation import (
     Actuation,
     default_stiffness,
     get_actuation,
+    ramp_value_text,
 )
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
 from rotomorph.lattice.paths import (
@@ -434,6 +435,7 @@ def heat_lattice(
     lift_off_tolerance: float | None = None,
     path_check: int = 1,
     youngs_modulus: float | None = None,
+    progress: Callable[[int], None] | None = None,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -516,6 +518,11 @@ def heat_lattice(
         default :func:`~rotomorph.lattice.model.paper_modulus`). Unloaded shapes do not depend
         on it; under a weight or in contact it sets the bending scale the weight is measured
         against.
+    progress
+        Called with 1 after every solved step of the ramp and of the path check's
+        sub-stepped ramp: ``steps * (1 + path_check)`` calls with a path check, ``steps``
+        without (halvings and the lift-off bisection are not counted). Each solve is also
+        announced on the ``rotomorph.progress`` logger ("ramp step 3 of 8 at 131.2 °C").
 
     Returns
     -------
@@ -589,9 +596,16 @@ def heat_lattice(
     events: list[tuple[float, int, bool]] = []  # every solve: parameter, iterations, success
 
     probes: dict[float, float] = {}  # parameter -> energy of the lifted branch minus resting
+    # the ramp being followed: its name and the step number of each requested value
+    ramp: dict[str, Any] = {
+        "name": "ramp",
+        "steps": dict(zip(values[1:].tolist(), range(1, steps + 1), strict=True)),
+    }
 
     def solve(p: float, state: State) -> StaticResult:
-        phase_log.info("natural field (%s) at %g", act.name, p)
+        k = ramp["steps"].get(p)
+        where = "(a halved step)" if k is None else f"{k} of {len(ramp['steps'])}"
+        phase_log.info("%s step %s at %s", ramp["name"], where, ramp_value_text(act, p))
         model = act.natural(lm, p)
         try:
             loads = loads_at(p)
@@ -614,8 +628,12 @@ def heat_lattice(
             if gap is not None:
                 probes[p] = gap
             if lifted is not None and gap is not None:
-                phase_log.info("lifted branch at %g is lower by %.3g N mm", p, -gap)
+                phase_log.info(
+                    "lifted branch at %s is lower by %.3g N mm", ramp_value_text(act, p), -gap
+                )
                 res = lifted
+        if progress is not None and k is not None:
+            progress(1)
         return res
 
     phase_log.info("set-up: Hessian sparsity pattern and ordering with the first solve")
@@ -624,6 +642,9 @@ def heat_lattice(
     checked: PathCheck | None = None
     if factor > 1:
         phase_log.info("path check: the ramp again with %d sub-steps per step", factor)
+        fine_values = sub_stepped(values, factor)[1:]
+        ramp["name"] = "path check ramp"
+        ramp["steps"] = dict(zip(fine_values.tolist(), range(1, len(fine_values) + 1), strict=True))
         # the solve closure appends to these: keep the first ramp's, collect the second's
         first_events, first_probes = list(events), dict(probes)
         events.clear()
@@ -633,7 +654,7 @@ def heat_lattice(
         try:
             fine = continuation(
                 solve,
-                sub_stepped(values, factor)[1:],
+                fine_values,
                 initial,
                 start=values[0],
                 max_halvings=max_halvings,

@@ -114,10 +114,29 @@ class DesignSimulation:
 
 
 def step_count(design: Any, steps: int) -> int:
-    """Progress units :func:`simulate_design` reports for ``design`` (for a progress bar)."""
+    """Progress units :func:`simulate_design` reports for ``design`` (for a progress bar):
+    every filament's states (``steps + 1`` each), or a lattice's ramp steps, those of its
+    path check's sub-stepped ramp included (:func:`~rotomorph.lattice.heating.heat_lattice`)."""
     if design.lattice is not None:
-        return 1
+        factor = int(getattr(design.contact, "path_check", 1) or 1)
+        return steps * (1 + factor) if factor > 1 else steps
     return len(design.filaments) * (steps + 1)
+
+
+def _about_seconds(seconds: float) -> str:
+    """An estimate in words: ``"under 1 s"``, ``"about 4 s"``, ``"about 3 min"``."""
+    if seconds < 1.0:
+        return "under 1 s"
+    if seconds < 90.0:
+        return f"about {seconds:.0f} s"
+    return f"about {seconds / 60:.0f} min"
+
+
+def _about_bytes(count: float) -> str:
+    """An estimate in words: ``"about 40 MB"``, ``"about 1.2 GB"``."""
+    if count < 1e9:
+        return f"about {max(count / 1e6, 1):.0f} MB"
+    return f"about {count / 1e9:.1f} GB"
 
 
 #: A helix fit describes a shape when its rms residual is below this fraction of its radius.
@@ -191,11 +210,13 @@ def _simulate_filaments(
     sims = []
     for i, fil in enumerate(design.filaments):
         phase_log.info(
-            "filament %d/%d: %s rod nodes, %d heating step(s)",
+            "filament %d of %d %r (%s rod nodes, %d heating steps)",
             i + 1,
             len(design.filaments),
+            fil.name or f"filament {i}",
             f"{fil.node_count():,}",
             steps,
+            extra={"task": True},
         )
         program = fil.to_program()
         fil_model = design_model(design, fil.active_material, fil.passive_material, model)
@@ -357,14 +378,15 @@ def _simulate_lattice(
     lat = design.lattice
     size = design_size(design)
     phase_log.info(
-        "set-up: %dx%d lattice geometry, %s rod nodes (estimated ~%.1f GB, ~%.0f s); "
-        "%d heating step(s)",
+        "set-up: %dx%d lattice geometry, %s rod nodes (estimated %s of memory, %s of "
+        "set-up); %d heating step(s)",
         lat.n,
         lat.n,
         f"{size.nodes:,}",
-        size.memory_bytes / 1e9,
-        size.setup_seconds,
+        _about_bytes(size.memory_bytes),
+        _about_seconds(size.setup_seconds),
         steps,
+        extra={"task": True},
     )
     lattice = lat.to_lattice()
     model = design_model(design, lat.active_material, lat.passive_material, model)
@@ -382,9 +404,8 @@ def _simulate_lattice(
             ramp_in_temperature=in_temperature,
             materials=design.material_set,
         ),
+        progress=progress,
     )
-    if progress is not None:
-        progress(1)
     phase_log.info("analysis: curvature changes, areas")
     pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
     rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])

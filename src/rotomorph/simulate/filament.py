@@ -56,6 +56,8 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
+#: What the solver is doing, for the command line's progress display (``rotomorph._progress``).
+phase_log = logging.getLogger("rotomorph.progress")
 
 #: Room temperature at which filaments are printed (°C).
 PRINT_TEMPERATURE = 25.0
@@ -336,6 +338,8 @@ def simulate_filament(
         field = fields[k] if w == k else _blend(fields[k], fields[k + 1], w - k)
         # loads of the step's temperature (a halved step's linear blend)
         t_w = float(temps[k] + (w - k) * (temps[k + 1] - temps[k]))
+        if w == int(w):
+            phase_log.info("heating step %d of %d at %.1f °C", int(w), s - 1, t_w)
         step_loads = loads(t_w) if callable(loads) else loads
         res = solve_static(
             rod_model(program, field),

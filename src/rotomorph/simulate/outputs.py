@@ -603,7 +603,8 @@ def write_run_results(
             programs=results.programs,
         )
     ]
-    paths.append(write_summary(out / "summary.json", summarize(results)))
+    summary = summarize(results)
+    paths.append(write_summary(out / "summary.json", summary))
     phase_log.info("writing: ParaView files")
     paths += write_vtk(results, out / "paraview")
     phase_log.info("writing: figures%s", " and movie" if movie else "")
@@ -616,4 +617,9 @@ def write_run_results(
             type(err).__name__,
             " ".join(str(err).split())[:300],
         )
+    # written again last, naming the files actually there (the movie is a GIF without ffmpeg)
+    names = sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file())
+    summary["files"] = sorted({*names, "summary.json"})
+    summary["movie"] = next((n for n in names if n.startswith("figures/morphing.")), None)
+    write_summary(out / "summary.json", summary)
     return paths

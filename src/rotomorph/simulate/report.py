@@ -80,6 +80,8 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
+#: What the report is computing, for the command line's progress display.
+phase_log = logging.getLogger("rotomorph.progress")
 
 Progress = Callable[[int, int], None]
 
@@ -288,6 +290,16 @@ def _heat(
     from rotomorph.design.lattices import sinusoidal_lattice
 
     n = 3 if quick else 5
+    phase_log.info(
+        "%s %dx%d lattice (%d ghost nodes, %d steps, %s)",
+        pattern,
+        n,
+        n,
+        ghosts,
+        steps,
+        "on the floor, contact" if contact else "no contact",
+        extra={"task": True},
+    )
     lattice = sinusoidal_lattice(n, 5.0, 1.25, ghosts, pattern)  # type: ignore[arg-type]
     try:
         actuation = mode(filament_model=model)
@@ -321,15 +333,32 @@ def _heat(
         return lattice, None, f"lattice solver failed: {' '.join(str(err).split())[:160]}"
 
 
-def _area_sd(fit: Fit, pattern: str, quick: bool, ghosts: int) -> float | None:
-    """Calibration sd of a lattice's final area (one-sided secants, :data:`SD_STEPS` steps)."""
+def _area_sd(
+    fit: Fit, pattern: str, quick: bool, ghosts: int, heat: Callable[..., Any] = _heat
+) -> float | None:
+    """Calibration sd of a lattice's final area (one-sided secants, :data:`SD_STEPS` steps;
+    :func:`sd_ramps` ramps)."""
 
     def area(m: FilamentModel) -> FloatArray:
-        _, res, _ = _heat(pattern, quick, SD_STEPS, at_resolution(m), ghosts)
+        _, res, _ = heat(pattern, quick, SD_STEPS, at_resolution(m), ghosts)
         return np.array([np.nan if res is None else res.final_area_ratio])
 
     _, sd = fit.propagate(area, central=False)
     return float(sd[0]) if np.isfinite(sd[0]) else None
+
+
+def sd_ramps(fit: Fit) -> int:
+    """Ramps :func:`_area_sd` runs for one lattice: the centre and one per direction."""
+    return 1 + sum(1 for d in fit.directions().T if np.any(d))
+
+
+def lattice_computations(fit: Fit, quick: bool) -> int:
+    """Lattice ramps :func:`_lattice_section` computes (or finds cached) in any case; a
+    refinement or a resting-state ramp it finds necessary on the way adds one each."""
+    if quick:
+        return 4 + 2  # without contact, and the expanding and contracting ones finer
+    # without contact; on the floor (4 coarse, 2 finer areas, 2 finer surfaces); the sd
+    return 4 + 4 + 2 + 2 + 2 * sd_ramps(fit)
 
 
 def _lattice_section(
@@ -339,8 +368,17 @@ def _lattice_section(
     quick: bool,
     steps: int,
     tick: Callable[[], None],
+    grow: Callable[[int], None] = lambda n: None,
 ) -> tuple[list[dict], list[Path]]:
-    """Lattice rows and, unless ``figs`` is None, their figures."""
+    """Lattice rows and, unless ``figs`` is None, their figures. ``tick()`` is called after
+    every lattice ramp (:func:`lattice_computations` of them, and ``grow(1)`` first for each
+    one more)."""
+
+    def _counted(*args: Any, **kwargs: Any) -> tuple[Any, Any, str]:
+        out = _heat(*args, **kwargs)
+        tick()
+        return out
+
     model = at_resolution(fit.model)
     from rotomorph.analysis.curvature import network_relative_curvature_change
     from rotomorph.plot.figure import new_figure, save_figure
@@ -353,10 +391,9 @@ def _lattice_section(
     fine: dict[str, Any] = {}
     coarse_g, fine_g = LATTICE_GHOSTS[quick]
     for pattern in ("expanding", "contracting", "dome", "saddle"):
-        results[pattern] = _heat(pattern, quick, steps, model, coarse_g)
+        results[pattern] = _counted(pattern, quick, steps, model, coarse_g)
         if quick and pattern in ("expanding", "contracting"):
-            fine[pattern] = _heat(pattern, quick, steps, model, fine_g)[1]
-        tick()
+            fine[pattern] = _counted(pattern, quick, steps, model, fine_g)[1]
 
     # contact-resolved ramps: self-contact, resting on the bath floor under buoyant weight.
     # These are the physical states, so the counted areas come from them (at two resolutions).
@@ -366,7 +403,7 @@ def _lattice_section(
 
     def on_floor(pattern: str, ghosts: int) -> tuple[Any, Any, str]:
         lift_tol = LIFT_OFF_TOLERANCE if pattern in ("dome", "saddle") else None
-        out = _heat(
+        out = _counted(
             pattern,
             quick,
             steps,
@@ -411,6 +448,7 @@ def _lattice_section(
             continue
         a_lo, a_hi = float(lo_res.final_area_ratio), float(hi_res.final_area_ratio)
         if abs(a_hi - a_lo) > CONVERGENCE_RTOL * abs(a_hi):
+            grow(1)
             finer = on_floor(pattern, 2 * fine_g)[1]
             if finer is not None:
                 fine[pattern] = finer
@@ -463,7 +501,7 @@ def _lattice_section(
                 None if fine[pattern] is None else fine[pattern].final_area_ratio,
                 predicted_sd=None
                 if quick or res is None
-                else _area_sd(fit, pattern, quick, coarse_g),
+                else _area_sd(fit, pattern, quick, coarse_g, _counted),
                 other=pairs[pattern][2],
                 resolution=pairs[pattern][:2],
                 resolution_unit="ghost nodes per edge",
@@ -497,7 +535,8 @@ def _lattice_section(
         lifted = None if touched is None else touched.first_lift_off()
         resting = None
         if not quick and lifted is not None:
-            _, resting, why_r = _heat(
+            grow(1)
+            _, resting, why_r = _counted(
                 pattern,
                 quick,
                 steps,
@@ -981,7 +1020,10 @@ def paper_report(
     quick
         3 × 3 lattices with 3 heating steps (for tests); the filament numbers are the same.
     progress
-        Called as ``progress(done, total)`` with the units finished since the last call.
+        Called as ``progress(done, total)`` with the units finished since the last call
+        and the units planned so far: the calibrations, three filament sections, the authors'
+        Fig. 4 sweeps and every lattice ramp (:func:`lattice_computations`; a refinement found
+        necessary on the way raises ``total`` by one).
     allow_unconverged
         When false, raise :class:`~rotomorph.errors.ConvergenceError` (after writing the
         report) if a reported number is not converged to 1 % between its two resolutions.
@@ -995,14 +1037,22 @@ def paper_report(
     figs = out / "figures"
     figs.mkdir(parents=True, exist_ok=True)
     lattice_steps = 3 if quick else LATTICE_STEPS
-    total = 4 + 5
+    # calibrations, three filament sections and the authors' Fig. 4 sweeps; then the
+    # lattice ramps
+    plan = {"total": 5}
 
     def tick() -> None:
         if progress is not None:
-            progress(1, total)
+            progress(1, plan["total"])
+
+    def grow(n: int) -> None:
+        plan["total"] += n
 
     timings: dict[str, float] = {}
+    phase_log.info("calibrations and filament predictions", extra={"task": True})
     val = validate_filaments()
+    fit = val.calibrations["all"].chosen
+    grow(lattice_computations(fit, quick))
     timings["calibrations and filament predictions"] = time.perf_counter() - t0
     tick()
     rows: list[dict] = []
@@ -1014,10 +1064,11 @@ def paper_report(
         (
             "lattices (Fig. 3G, 4)",
             lambda: _lattice_section(
-                val.calibrations["all"].chosen, figs, quick=quick, steps=lattice_steps, tick=tick
+                fit, figs, quick=quick, steps=lattice_steps, tick=tick, grow=grow
             ),
         ),
     ):
+        phase_log.info("%s", name, extra={"task": True})
         t = time.perf_counter()
         r, f = section()
         rows += r
@@ -1026,6 +1077,7 @@ def paper_report(
         if name != "lattices (Fig. 3G, 4)":
             tick()
     t = time.perf_counter()
+    phase_log.info("authors' Fig. 4 simulation rebuilt (two stretch sweeps)", extra={"task": True})
     published = _published(out, figs, quick)
     figures += published[1]
     timings["authors' Fig. 4 simulation rebuilt (two stretch sweeps)"] = time.perf_counter() - t

@@ -1,8 +1,9 @@
 """The ``rotomorph sweep`` command: parser arguments and the command (logic lives here).
 
 ``rotomorph sweep SWEEP.toml -o DIR [--scheduler tcp://HOST:PORT | --workers N] [--plot]``
-runs (or resumes) the sweep into ``DIR`` with a progress bar (done / failed / remaining and an
-ETA) and prints a one-line summary. ``rotomorph sweep --schema`` prints the sweep file's JSON
+runs (or resumes) the sweep into ``DIR`` with its progress (runs done of the total, ok / failed /
+to go, elapsed time and ETA: a bar on a terminal, a line every 10 s elsewhere) and prints a
+one-line summary. ``rotomorph sweep --schema`` prints the sweep file's JSON
 Schema. Running the same command again after an interruption computes only the missing runs.
 Exit code 1 when runs were lost to a crashed worker (run again to finish them).
 """
@@ -60,31 +61,19 @@ def check_scheduler_address(address: str) -> None:
         ) from None
 
 
-class _Bar:
-    """A tqdm bar fed with :class:`~rotomorph.sweep.runner.SweepProgress` counts."""
+def _show(display: Any) -> Any:
+    """A ``run_sweep`` progress callback feeding a :class:`rotomorph._progress.ProgressDisplay`
+    (runs found finished count as done, not toward the ETA's rate)."""
 
-    def __init__(self) -> None:
-        self.bar: Any = None
+    def progress(p: Any) -> None:
+        if display.total != p.total:
+            display.set_total(p.total)
+            display.set_initial(p.skipped)
+        found = f", {p.skipped} found finished" if p.skipped else ""
+        display.set_note(f"{p.ok} ok, {p.failed} failed, {p.remaining} to go{found}")
+        display.set_done(p.done)
 
-    def __call__(self, p: Any) -> None:
-        if self.bar is None:
-            from tqdm import tqdm
-
-            self.bar = tqdm(
-                total=p.total,
-                initial=p.skipped,
-                desc="sweep",
-                unit="run",
-                disable=not sys.stderr.isatty(),
-                leave=False,
-                smoothing=0.1,
-            )
-        self.bar.set_postfix(ok=p.ok, failed=p.failed, remaining=p.remaining, refresh=False)
-        self.bar.update(p.done - self.bar.n)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
+    return progress
 
 
 def command(args: argparse.Namespace) -> int:
@@ -112,13 +101,14 @@ def command(args: argparse.Namespace) -> int:
         raise InvalidParameterError("-o/--output", f"{args.output}: exists and is not a folder")
     check_writable(out, "-o/--output", create_parent=False)
     sweep = load_sweep(path)
+    from rotomorph._progress import progress_display
     from rotomorph.sweep.runner import run_sweep
 
-    bar = _Bar()
-    try:
-        result = run_sweep(sweep, out, scheduler=args.scheduler, workers=args.workers, progress=bar)
-    finally:
-        bar.close()
+    verbose, quiet = getattr(args, "verbose", False), getattr(args, "quiet", False)
+    with progress_display("sweep", None, "runs", verbose=verbose, quiet=quiet) as shown:
+        result = run_sweep(
+            sweep, out, scheduler=args.scheduler, workers=args.workers, progress=_show(shown)
+        )
     statuses = result.table.column("status").to_pylist()
     counts = {s: statuses.count(s) for s in ("ok", "invalid", "failed")}
     p = result.progress
