@@ -73,7 +73,8 @@ class ProgressDisplay:
     total
         Units of work, or ``None`` while unknown (:meth:`set_total`).
     unit
-        Plural noun of a unit (``"steps"``, ``"runs"``).
+        Plural noun of a unit (``"steps"``, ``"runs"``); ``""`` with no ``total``: nothing is
+        counted, the display shows the time and the note.
     stream
         Where to write (default ``sys.stderr``).
     tty
@@ -224,19 +225,23 @@ class ProgressDisplay:
     def status(self) -> str:
         """The line written where there is no terminal (without the ``rotomorph:`` prefix)."""
         with self._lock:
-            if self.total is None:
-                count = f"{self.done} {self.unit}"
+            if self.total is None and not self.unit:  # nothing counted: time and note only
+                count = ""
+            elif self.total is None:
+                count = f"{self.done} {self.unit}, "
             else:
                 share = 100.0 * self.done / self.total if self.total else 100.0
-                count = f"{self.done} of {self.total} {self.unit} ({share:.0f} %)"
+                count = f"{self.done} of {self.total} {self.unit} ({share:.0f} %), "
             eta = self.eta()
             timing = f"{format_duration(self.elapsed())} elapsed" + (
                 "" if eta is None else f", ETA {format_duration(eta)}"
             )
             note = f"; {self.note}" if self.note else ""
-            return f"{self.desc}: {count}, {timing}{note}"
+            return f"{self.desc}: {count}{timing}{note}"
 
     def _bar_format(self) -> str:
+        if self.total is None and not self.unit:
+            return "{desc}: {elapsed}{postfix}"
         if self.total is None:
             return "{desc}: {n_fmt} {unit}, {elapsed}{postfix}"
         return "{desc}: {n_fmt} of {total_fmt} {unit} |{bar}| {elapsed}, ETA {remaining}{postfix}"

@@ -621,11 +621,16 @@ def _cmd_inverse(args: argparse.Namespace) -> int:
     if out.exists() and not args.force:
         raise UsageError(f"-o/--output: {args.output}: exists; use --force to replace it")
     _check_writable(out, create_parent=True, inputs=[target])
-    with _display(args, "inverse", None, "iterations") as shown:
+    from rotomorph.inverse.targets import load_target
+
+    spec = load_target(str(target))  # checked here: a bad file is refused before any work
+    lattice = spec.kind != "curve"  # a lattice's optimiser reports its iterations
+    total = spec.options.max_iterations if lattice else None
+    with _display(args, "inverse", total, "iterations (at most)" if lattice else "") as shown:
 
         def progress(iteration: int, objective: float) -> None:
+            shown.set_note(f"iteration {iteration}: objective {objective:.4g}")
             shown.set_done(iteration)
-            shown.set_note(f"objective {objective:.4g}")
 
         text = inverse_file(target, out, progress=progress)
     _print(text)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import logging
 import math
 import os
 from collections.abc import Callable
@@ -38,6 +39,9 @@ from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
 from rotomorph.lattice.actuation import ProgramActuation
 from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
+
+#: What the inverse design is doing, for the command line's progress display.
+phase_log = logging.getLogger("rotomorph.progress")
 
 __all__ = [
     "InverseRun",
@@ -204,6 +208,11 @@ def run_inverse(
     name = target.name or target.kind
     if target.kind == "curve":
         assert target.curve is not None
+        phase_log.info(
+            "%s curve: print program along the target, verified by the forward simulation",
+            target.curve.family,
+            extra={"task": True},
+        )
         speeds = (opt.min_speed, opt.max_speed)
         fm = target.filament_model()
         table = cached_response_table(
@@ -294,6 +303,15 @@ def run_inverse(
         if progress is not None:
             progress(it, value)
 
+    phase_log.info(
+        "%dx%d lattice, %s target: edge modes and speeds by adjoint optimisation (at most %d "
+        "iterations), then rounded and verified",
+        spec.n,
+        spec.n,
+        target.kind,
+        opt.max_iterations,
+        extra={"task": True},
+    )
     surf = target.surface_target()
     env = lattice_surroundings(target.contact, lat, opt.temperature, materials=target.material_set)
     env.pop("friction", None)  # 0: the target file refuses friction
