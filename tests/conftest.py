@@ -48,3 +48,22 @@ def require_tool():
         pytest.skip(message + "; .ci/run installs it and requires it")
 
     return _require
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Order and group the suite for its xdist workers (``-n auto --dist loadgroup``).
+
+    * Slow tests first (a stable sort): the long ones start while every worker is free and
+      the short ones fill in behind them, instead of one long test starting last.
+    * The tests of one file run on one worker unless a test names its own ``xdist_group``:
+      module- and session-scoped fixtures (a simulated run, a sweep on a process pool) are
+      then computed once, not once per worker. Runs before xdist's own hook, which reads the
+      groups (``tryfirst``).
+    """
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+    if getattr(config.option, "dist", "no") != "loadgroup":
+        return
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::", 1)[0]))
