@@ -212,3 +212,15 @@ def test_sweep_shows_its_bar_on_a_terminal(tmp_path):
     assert re.match(
         r"sweep: 3 of 3 runs \|█+\| \d\d:\d\d, ETA 00:00, 3 ok, 0 failed, 0 to go", last
     ), text
+
+
+def test_lattice_set_up_estimates_in_words():
+    """The set-up line's estimates: never "~0 s" or "~0.0 GB" for a small lattice."""
+    from rotomorph.simulate.design import _about_bytes, _about_seconds
+
+    assert _about_seconds(0.3) == "under 1 s"
+    assert _about_seconds(4.2) == "about 4 s"
+    assert _about_seconds(300.0) == "about 5 min"
+    assert _about_bytes(4.6e6) == "about 5 MB"
+    assert _about_bytes(1e3) == "about 1 MB"
+    assert _about_bytes(2.54e9) == "about 2.5 GB"
