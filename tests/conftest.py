@@ -52,18 +52,47 @@ def require_tool():
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Order and group the suite for its xdist workers (``-n auto --dist loadgroup``).
-
-    * Slow tests first (a stable sort): the long ones start while every worker is free and
-      the short ones fill in behind them, instead of one long test starting last.
-    * The tests of one file run on one worker unless a test names its own ``xdist_group``:
-      module- and session-scoped fixtures (a simulated run, a sweep on a process pool) are
-      then computed once, not once per worker. Runs before xdist's own hook, which reads the
-      groups (``tryfirst``).
-    """
+    """Slow tests first (a stable sort): on the xdist workers the long ones start while every
+    worker is free and the short ones fill in behind them, instead of one long test starting
+    last and running alone."""
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
-    if getattr(config.option, "dist", "no") != "loadgroup":
-        return
-    for item in items:
-        if item.get_closest_marker("xdist_group") is None:
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::", 1)[0]))
+
+
+#: Tests that share one heavy computation, kept on one worker one after the other (the
+#: second reads the first's cached result instead of waiting for it on another worker): the
+#: README's ``rotomorph paper`` and the README table test compute the same report.
+SHARED_WORK = {
+    "tests/test_readme_shell.py::test_readme_commands_run_verbatim[quickstart]": "paper-report",
+    "tests/simulate/test_readme_table.py::test_readme_table_equals_the_report": "paper-report",
+}
+#: Long, independent tests of one file that may run on different workers (one scope each).
+EACH_ITS_OWN = ("tests/test_readme_shell.py::test_readme_commands_run_verbatim[",)
+
+
+def xdist_scope(nodeid: str) -> str:
+    """The unit of work a test belongs to on the xdist workers: its file (module- and
+    session-scoped fixtures are then computed once, not once per worker), or its own or a
+    shared unit (:data:`SHARED_WORK`, :data:`EACH_ITS_OWN`)."""
+    if nodeid in SHARED_WORK:
+        return SHARED_WORK[nodeid]
+    if nodeid.startswith(EACH_ITS_OWN):
+        return nodeid
+    return nodeid.split("::", 1)[0]
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    """``--dist loadfile`` (pyproject's addopts) with the units of :func:`xdist_scope`, taken in
+    collection order (slow tests first). The ``xdist_group`` mark cannot do this: pytest-xdist
+    3.8 groups by rewriting node ids, which pytest 9.2 no longer honours, so the mark is
+    silently ignored (pytest-dev/pytest-xdist#1386)."""
+    if config.getoption("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class SuiteScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_scope(nodeid)
+
+    config.option.loadscopereorder = False  # keep the collection order: slow units first
+    return SuiteScheduling(config, log)  # type: ignore[arg-type]

@@ -384,22 +384,17 @@ def _clean_env(home: Path) -> dict[str, str]:
 
 
 def _block_params() -> list:
-    """One test per bash block with a command to run here, each its own xdist group (so the
-    blocks run in parallel); the block that runs the full ``rotomorph paper`` shares its
-    group with the README table test, which computes the same report (the second of them
-    reads the first's cached results instead of waiting for it on another worker)."""
+    """One test per bash block with a command to run here. On the xdist workers each is a unit
+    of its own (the blocks run in parallel), and the Quickstart's, which runs the full
+    ``rotomorph paper``, shares one with the README table test, which computes the same report
+    (``tests/conftest.py``, ``SHARED_WORK``)."""
     params = []
     for block in readme_blocks(README.read_text(encoding="utf-8")):
         if not any(not c.startswith(SKIP) for c in block.commands):
             continue
         slug = re.sub(r"[^a-z0-9]+", "-", block.section.lower()).strip("-")
-        group = "paper-report" if _runs_paper(block) else f"readme-{slug}"  # blocks in parallel
-        params.append(pytest.param(block, id=slug, marks=[pytest.mark.xdist_group(group)]))
+        params.append(pytest.param(block, id=slug))
     return params
-
-
-def _runs_paper(block: Block) -> bool:
-    return any(c.startswith("rotomorph paper") and "--quick" not in c for c in block.commands)
 
 
 #: What a block's commands promise, by section: files that must exist after them.
@@ -461,3 +456,16 @@ def test_every_runnable_block_has_its_promises_or_none():
     """A renamed README section keeps its promised files checked (or the table is updated)."""
     sections = {b.section for b in readme_blocks(README.read_text(encoding="utf-8"))}
     assert set(PROMISED) <= sections, set(PROMISED) - sections
+
+
+def test_the_shared_report_units_name_real_tests():
+    """``tests/conftest.py`` keeps the README's full ``rotomorph paper`` and the README table
+    test on one xdist worker by node id: both ids must exist (a rename would part them)."""
+    from conftest import SHARED_WORK
+
+    ids = {p.id for p in _block_params()}
+    for nodeid in SHARED_WORK:
+        path, name = nodeid.split("::", 1)
+        function, _, param = name.partition("[")
+        assert f"def {function}(" in (ROOT / path).read_text(encoding="utf-8"), nodeid
+        assert not param or param.rstrip("]") in ids, nodeid

@@ -20,7 +20,6 @@ def _table(name: str) -> str:
 
 
 @pytest.mark.slow
-@pytest.mark.xdist_group("paper-report")  # with the README's `rotomorph paper`: one computation
 def test_readme_table_equals_the_report() -> None:
     rows, summary = paper_rows(quick=False)
     table = prediction_table(rows, summary)
