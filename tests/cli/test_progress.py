@@ -122,7 +122,9 @@ def test_filament_simulate_in_a_log_says_steps_and_degrees(tmp_path, capsys, fas
     assert code == EXIT_OK, err
     lines = [ln for ln in err.splitlines() if ln.startswith("rotomorph: simulate: ")]
     assert lines, err
-    assert all(re.search(r"\d of 5 steps \(\d+ %\), \d+ s elapsed", ln) for ln in lines), lines
+    # elapsed as format_duration writes it: "12 s", "1 min 05 s" (a loaded machine), "1 h 02 min"
+    elapsed = r"(\d+ h \d+ min|(\d+ min )?\d+ s) elapsed"
+    assert all(re.search(r"\d of 5 steps \(\d+ %\), " + elapsed, ln) for ln in lines), lines
     assert any("°C" in ln for ln in lines), lines
     assert lines[-1].startswith("rotomorph: simulate: 5 of 5 steps") and "(finished)" in lines[-1]
 
