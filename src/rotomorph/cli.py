@@ -672,7 +672,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if args.active_fraction is not None and not 0.0 < args.active_fraction <= 1.0:
         raise UsageError(f"--active-fraction: must lie in (0, 1]; got {args.active_fraction:g}")
     out.parent.mkdir(parents=True, exist_ok=True)
-    with _phases():
+    with _display(args, "calibrate", None, ""):
         run = calibrate_files(tables, out, settings, lattices=not args.no_lattices)
     _print(run.summary_line())
     _print("what the tables determine (at the fit):")
