@@ -49,3 +49,17 @@ def test_overlap_is_physical_only_with_a_contact_model():
     assert assess(sc, {"contact": True}, 1)[0].verdict == "yes"
     # with contact modelled, a missing clearance is not a missing check
     assert assess({"converged": [1], "stable": [1]}, {"contact": True}, 1)[0].verdict == "yes"
+
+
+def test_interpenetrating_stack_layers_are_not_physical_even_with_contact():
+    sc = {
+        "converged": np.ones(3),
+        "stable": np.ones(3),
+        "min_clearance": np.full(3, 1.02),
+        "stack_overlaps": np.array([0.0, 808.0, np.nan]),
+    }
+    v = assess(sc, {"contact": True}, 3)
+    assert [x.verdict for x in v] == ["yes", "no", "unknown"]
+    assert v[1].text() == "NOT PHYSICAL: 808 layer pairs of the printed stack interpenetrate"
+    assert "stack admissibility not checked" in v[2].reasons
+    assert run_verdict(v).verdict == "no"  # the end inherits the earlier failure

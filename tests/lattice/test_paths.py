@@ -64,6 +64,17 @@ def test_choose_end():
     assert failed.kept == "steps" and "failed" in failed.note
 
 
+def test_choose_end_never_keeps_an_inadmissible_end():
+    # the sub-stepped end is lower, but its stack's layers interpenetrate: never chosen
+    lower = choose_end((0.222, 0.214), (True, True), False, 2, admissible=(True, False))
+    assert lower.kept == "steps" and lower.admissible == (True, False)
+    assert "sub-stepped one is not admissible" in lower.note
+    # the requested end is inadmissible, the sub-stepped one admissible (even if higher)
+    other = choose_end((0.1, 0.3), (True, True), False, 2, admissible=(False, True))
+    assert other.kept == "sub-steps" and "requested one is not admissible" in other.note
+    assert other.stable == (True, True)  # stability is reported as it was found
+
+
 @pytest.mark.parametrize("bad", [0, 9, 1.5, 2.0, True, None, "2"])
 def test_check_factor_refuses_anything_but_small_integers(bad):
     with pytest.raises(InvalidParameterError, match="path_check"):
@@ -140,7 +151,7 @@ def test_path_check_records_both_ramps():
 
 
 def test_kept_sub_stepped_ramp_is_sampled_at_the_requested_steps(monkeypatch):
-    def prefer_sub_steps(energy, stable, same, factor):  # type: ignore[no-untyped-def]
+    def prefer_sub_steps(energy, stable, same, factor, admissible=(True, True)):  # type: ignore[no-untyped-def]
         return PathCheck(factor, energy, stable, "sub-steps", False)
 
     monkeypatch.setattr(heating, "choose_end", prefer_sub_steps)

@@ -76,6 +76,7 @@ DEFAULT_UNITS: Mapping[str, str] = {
     "lowest_eigenvalue": "N/mm^2",
     "min_clearance": "1",
     "max_axial_strain": "1",
+    "stack_overlaps": "1",
     "directors": "1",
     "active_normal": "1",
     "twist": "1/mm",

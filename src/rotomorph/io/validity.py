@@ -1,7 +1,8 @@
 """Is a stored state physical? One verdict per step, from the flags a run stores.
 
 A state is physical when the solve that produced it converged, the equilibrium is stable and
-no two filaments pass through each other. Runs store what they checked as per-step scalars:
+no two filaments pass through each other — for a lattice printed in layers, no two layers of its
+printed stack either. Runs store what they checked as per-step scalars:
 
 ``converged``
     1 where the step's solve converged, 0 where not.
@@ -16,6 +17,10 @@ no two filaments pass through each other. Runs store what they checked as per-st
     rod model stretches by a linear, small-strain law; above :data:`MAX_AXIAL_STRAIN` the state
     is outside the model (a dead load that flipped a filament and pulls it to several times its
     length converges, and is nonsense). Runs that do not store it are not flagged for it.
+``stack_overlaps``
+    Lattices: layer pairs of the printed stack that interpenetrate
+    (:mod:`rotomorph.lattice.admissibility`; > 0 is not physical, contact or not). Absent for
+    filaments, whose section is one layer (the clearance check covers them).
 
 A scalar that is missing, or NaN at a step, is **unknown** at that step — never counted as
 fine. Whether contact was modelled is read from ``metadata["contact"]`` (absent: not
@@ -93,7 +98,8 @@ def assess(
     Parameters
     ----------
     scalars
-        Per-step scalars of a run (``converged``, ``stable``, ``min_clearance`` are read).
+        Per-step scalars of a run (``converged``, ``stable``, ``min_clearance`` and, where
+        present, ``stack_overlaps`` are read).
     metadata
         Run metadata (``contact``: whether contact was modelled).
     n_steps
@@ -128,6 +134,11 @@ def assess(
                 f"edges strained {100 * strain:.0f} % against their natural length (the rod "
                 f"model holds to {100 * MAX_AXIAL_STRAIN:.0f} %)"
             )
+        stack = _flag(scalars, "stack_overlaps", k)
+        if stack > 0:
+            failed.append(f"{int(stack)} layer pairs of the printed stack interpenetrate")
+        elif np.isnan(stack) and "stack_overlaps" in scalars:
+            unknown.append("stack admissibility not checked")
         if failed:
             out.append(StepVerdict("no", tuple(failed)))
         elif unknown:

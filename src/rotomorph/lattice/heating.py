@@ -46,6 +46,7 @@ from rotomorph.lattice.actuation import (
     get_actuation,
     ramp_value_text,
 )
+from rotomorph.lattice.admissibility import admissibility, overlap_counts
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
 from rotomorph.lattice.paths import (
     SAME_SHAPE_TOL,
@@ -267,6 +268,10 @@ class HeatingResult:
     path_check
         With ``path_check > 1``: the :class:`~rotomorph.lattice.paths.PathCheck` (both ramps'
         final energies and which was kept); None without.
+    stack_overlaps
+        Layer pairs of the printed stack that interpenetrate at each step
+        (:func:`rotomorph.lattice.admissibility.admissibility`; 0: admissible); None for
+        results made before the check existed.
     """
 
     parameter: FloatArray
@@ -296,6 +301,21 @@ class HeatingResult:
     lift_off_bracket: tuple[float, float] | None = None
     buckling_bracket: tuple[float, float] | None = None
     path_check: PathCheck | None = None
+    stack_overlaps: IntArray | None = None
+
+    @property
+    def admissible(self) -> tuple[bool | None, ...]:
+        """Per step: no two layers of the printed stack interpenetrate (None: not checked)."""
+        if self.stack_overlaps is None:
+            return (None,) * len(self.parameter)
+        return tuple(bool(c == 0) for c in self.stack_overlaps)
+
+    @property
+    def physical(self) -> tuple[bool, ...]:
+        """Per step: a physical state (converged, certified stable and admissible)."""
+        return tuple(
+            s is True and a is True for s, a in zip(self.stable, self.admissible, strict=True)
+        )
 
     @property
     def final_area_ratio(self) -> float:
@@ -673,6 +693,11 @@ def heat_lattice(
             ),
             same,
             factor,
+            admissible=(
+                admissibility(lattice, path.final.state, contact=settings).admissible,
+                fine is not None
+                and admissibility(lattice, fine.final.state, contact=settings).admissible,
+            ),
         )
         if checked.kept == "sub-steps":
             assert fine is not None
@@ -718,6 +743,8 @@ def heat_lattice(
         if ok and k < len(values) and p == values[k]:
             k += 1
     halvings, wall = per_row(path.steps, per_step)
+    states = (lm.model.reference_state(), *(r.state for r in finals))
+    overlaps = overlap_counts(lattice, states, contact=settings)
     fused = fused_pairs(ref, lattice.network.edges, 2.0 * lattice.radius)
     rows = [_measure(lattice, p, ref, loop, fused) for p in positions]
     ratios = np.stack([r[3] for r in rows])
@@ -747,7 +774,7 @@ def heat_lattice(
         lattice=lattice,
         model=lm,
         actuation=act.name,
-        states=(lm.model.reference_state(), *(r.state for r in finals)),
+        states=states,
         stable=(True, *(_stable_flag(r) for r in finals)),
         lowest_eigenvalue=np.r_[np.nan, path.lowest_eigenvalues[per_step - 1 :: per_step]],
         max_axial_strain=np.r_[0.0, [getattr(r, "max_axial_strain", np.nan) for r in finals]],
@@ -758,6 +785,7 @@ def heat_lattice(
         lift_off_bracket=brackets[0],
         buckling_bracket=brackets[1],
         path_check=checked,
+        stack_overlaps=overlaps,
     )
 
 
@@ -833,9 +861,11 @@ def _lift_probe(
     rocks over), where its elastic equilibrium under its weight is solved with the ramp's
     contact model. It returns ``(best lifted result or None, its energy minus the resting
     one or None, Newton iterations spent)``. A lifted
-    result is returned only if it is certified stable, lower in total energy (elastic +
-    weight + barrier) and actually off the floor. A lift found inside a halved or path-check
-    sub-step is recorded in the row of the step it leads to (``_gaps_per_step``).
+    result is returned only if it is certified stable, admissible (no two layers of the
+    printed stack interpenetrate: :mod:`rotomorph.lattice.admissibility`), lower in total
+    energy (elastic + weight + barrier) and actually off the floor. A lift found inside a
+    halved or path-check sub-step is recorded in the row of the step it leads to
+    (``_gaps_per_step``).
 
     With friction the comparison is between potential energies (elastic + weight + barrier):
     lagged friction is dissipation, not a potential, so it is left out of both. The lifted
@@ -904,7 +934,12 @@ def _lift_probe(
             trial.energy,
             rest_energy,
         )
-        if lift > diameter and trial.stable and (best is None or trial.energy < best.energy):
+        if (
+            lift > diameter
+            and trial.stable
+            and (best is None or trial.energy < best.energy)
+            and admissibility(lattice, trial.state, contact=settings).admissible
+        ):
             best = trial
     if best is None:
         return None, None, spent

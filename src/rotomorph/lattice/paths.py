@@ -63,6 +63,9 @@ class PathCheck:
     tie
         The ends differ in shape but not in total energy (:data:`ENERGY_TIE`): the ramp as
         requested is kept.
+    admissible
+        Whether each ramp's end state is admissible (no two layers of the printed stack
+        interpenetrate); an inadmissible end is never kept over an admissible one.
     discarded_iterations, discarded_wall_time
         Newton iterations and seconds of the ramp not kept (not in the result's
         ``iterations`` and ``wall_time``).
@@ -76,6 +79,7 @@ class PathCheck:
     discarded_iterations: int = 0
     discarded_wall_time: float = 0.0
     tie: bool = False
+    admissible: tuple[bool, bool] = (True, True)
 
     @property
     def note(self) -> str:
@@ -96,12 +100,16 @@ class PathCheck:
             f"path check: the ramp as requested and {second} end in different states "
             f"(total energy {e1:.6g} and {e2:.6g} N mm"
         )
+        kept = "sub-stepped" if self.kept == "sub-steps" else "requested"
+        if not all(self.admissible):
+            which = "requested" if not self.admissible[0] else "sub-stepped"
+            return (
+                f"{ends}; the {which} one is not admissible: layers of the printed stack "
+                f"interpenetrate); the {kept} one is kept"
+            )
         if not all(self.stable):
             which = "requested" if not self.stable[0] else "sub-stepped"
-            return (
-                f"{ends}; the {which} one is not certified stable); the "
-                f"{'sub-stepped' if self.kept == 'sub-steps' else 'requested'} one is kept"
-            )
+            return f"{ends}; the {which} one is not certified stable); the {kept} one is kept"
         return (
             f"{ends}, both certified stable): the lattice is multistable and the one lower in "
             f"total energy is kept ({self.kept})"
@@ -138,21 +146,36 @@ def shape_distance(a: FloatArray, b: FloatArray) -> float:
 
 
 def choose_end(
-    energy: tuple[float, float], stable: tuple[bool, bool], same_shape: bool, factor: int
+    energy: tuple[float, float],
+    stable: tuple[bool, bool],
+    same_shape: bool,
+    factor: int,
+    admissible: tuple[bool, bool] = (True, True),
 ) -> PathCheck:
     """Which ramp to keep: the requested one unless the sub-stepped one ends in a different
-    state that is certified stable and either lower in total energy (by more than
-    :data:`ENERGY_TIE`) or the only stable one. ``energy`` holds both final total energies
-    (NaN for a failed ramp)."""
+    state that is certified stable and admissible (no two layers of the printed stack
+    interpenetrate) and either lower in total energy (by more than :data:`ENERGY_TIE`) or the
+    only such one. ``energy`` holds both final total energies (NaN for a failed ramp);
+    ``admissible`` both ends' admissibility (an inadmissible end counts as not stable: it is
+    never chosen over an admissible one)."""
     e1, e2 = (float(e) for e in energy)
-    s1, s2 = bool(stable[0]), bool(stable[1]) and np.isfinite(e2)
+    s1 = bool(stable[0]) and bool(admissible[0])
+    s2 = bool(stable[1]) and bool(admissible[1]) and np.isfinite(e2)
     same = bool(np.isfinite(e2) and same_shape)
     tie = bool(
         not same and s1 and s2 and abs(e1 - e2) <= ENERGY_TIE * max(abs(e1), abs(e2), 1e-300)
     )
     second = not same and not tie and s2 and (not s1 or e2 < e1)
     kept = "sub-steps" if second else "steps"
-    return PathCheck(factor, (e1, e2), (s1, s2), kept, same, tie=tie)
+    return PathCheck(
+        factor,
+        (e1, e2),
+        (bool(stable[0]), bool(stable[1]) and bool(np.isfinite(e2))),
+        kept,
+        same,
+        tie=tie,
+        admissible=(bool(admissible[0]), bool(admissible[1])),
+    )
 
 
 def per_row(steps: Sequence[Any], per_step: int) -> tuple[IntArray, FloatArray]:

@@ -421,6 +421,8 @@ def _simulate_lattice(
         "edge_strain": np.asarray(res.mean_edge_strain, dtype=float),
         "min_clearance": np.asarray(res.min_clearance, dtype=float),
     }
+    if res.stack_overlaps is not None:  # layer pairs of the printed stack interpenetrating
+        scalars["stack_overlaps"] = np.asarray(res.stack_overlaps, dtype=float)
     fields = {
         "relative_curvature_change": rel,
         "edge_end_to_end_ratio": np.asarray(res.edge_ratios, dtype=float),
@@ -450,6 +452,7 @@ def _simulate_lattice(
             "relative_curvature_change": "1",
             "edge_end_to_end_ratio": "1",
             "min_clearance": "1",
+            "stack_overlaps": "1",
         },
         metadata=metadata,
         lattice=res,

@@ -90,6 +90,30 @@ FILAMENT_LENGTH = 30.0  # mm, as in examples/designs
 _row = row
 
 
+def _end_physical(res: Any) -> tuple[bool, str]:
+    """Whether a lattice ramp's end state is physical (certified stable and admissible: no two
+    layers of its printed stack interpenetrate, :mod:`rotomorph.lattice.admissibility`), and
+    what fails ("" when nothing does)."""
+    if res is None:
+        return False, "no state"
+    why = []
+    if not bool(res.stable[-1]):
+        why.append("not certified stable")
+    overlaps = getattr(res, "stack_overlaps", None)
+    if overlaps is None:
+        why.append("stack admissibility not checked")
+    elif int(overlaps[-1]) > 0:
+        why.append(f"{int(overlaps[-1])} layer pairs of the printed stack interpenetrate")
+    return not why, "; ".join(why)
+
+
+def _flagged(title: str, res: Any) -> tuple[str, str]:
+    """A figure title with NOT PHYSICAL (and its reason) added where the end state is not
+    physical, and the title's colour."""
+    ok, why = _end_physical(res)
+    return (title, "k") if ok else (f"{title}\nNOT PHYSICAL: {why}", "tab:red")
+
+
 @dataclass(frozen=True)
 class PaperReport:
     """What :func:`paper_report` wrote.
@@ -527,9 +551,10 @@ def _lattice_section(
                     (res is not None and float(np.min(res.min_clearance)) >= 1.0)
                     if quick
                     else fine[pattern] is not None
-                    and bool(fine[pattern].stable[-1])
                     and float(np.min(fine[pattern].min_clearance)) >= 0.999
-                ),
+                )
+                and _end_physical(res if quick else fine[pattern])[0],
+                physical_reason=_end_physical(res if quick else fine[pattern])[1],
             )
         )
         lifted = None if touched is None else touched.first_lift_off()
@@ -564,6 +589,8 @@ def _lattice_section(
                     f"rise {float(resting.floor_lift[-1]):.2f} mm, "
                     f"{int(resting.contacts_active[-1])} contacts; "
                     + ("" if resting.path_check is None else resting.path_check.note),
+                    physical=_end_physical(resting)[0],
+                    physical_reason=_end_physical(resting)[1],
                 )
             )
         if not quick and res is not None:
@@ -586,7 +613,12 @@ def _lattice_section(
                         if overlap
                         else ""
                     ),
-                    physical=not overlap,
+                    physical=not overlap and _end_physical(res)[0],
+                    physical_reason="; ".join(
+                        w
+                        for w in ("filaments overlap" if overlap else "", _end_physical(res)[1])
+                        if w
+                    ),
                 )
             )
         if res is not None:
@@ -602,7 +634,20 @@ def _lattice_section(
                     label=f"{pattern} (measured, 175 °C)")  # fmt: skip
     ax.set_xlabel("ramp parameter: temperature (°C)")
     ax.set_ylabel("A/A0 (–)")
-    ax.set_title("Fig. 3G: lattice area on heating")
+    counted_ends = [
+        results[p][1] if quick else fine[p] for p in ("expanding", "contracting")
+    ]  # the states the area rows count
+    bad = [
+        (p, _end_physical(r)[1])
+        for p, r in zip(("expanding", "contracting"), counted_ends, strict=True)
+        if not _end_physical(r)[0]
+    ]
+    ax.set_title(
+        "Fig. 3G: lattice area on heating"
+        + "".join(f"\nNOT PHYSICAL ({p}): {why}" for p, why in bad),
+        color="tab:red" if bad else "k",
+        fontsize=10 if bad else None,
+    )
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     if figs is not None:
@@ -622,9 +667,8 @@ def _lattice_section(
             if res.contact is not None
             else f"no contact needed: clearance {np.min(res.min_clearance):.2f} diameters"
         )
-        f = lattice_tube_figure(
-            lattice, res, rel, title=f"{pattern} lattice, {res.parameter[k]:.3g} °C ({state})"
-        )
+        title, colour = _flagged(f"{pattern} lattice, {res.parameter[k]:.3g} °C ({state})", res)
+        f = lattice_tube_figure(lattice, res, rel, title=title, title_colour=colour)
         paths.append(save_figure(f, figs / f"lattice_{pattern}_views.png"))
     # Fig. 4C/F: sign and characteristic curvature vs strain
     fig = new_figure(10.0, 5.0)
@@ -653,6 +697,8 @@ def _lattice_section(
                 calibrated_without="lattice (never fitted)",
                 unit="1",
                 figure="fig4cf_characteristic_curvature.png",
+                physical=_end_physical(res)[0],
+                physical_reason=_end_physical(res)[1],
                 note=why
                 or f"{size}; sign of the fitted Gaussian curvature of the branch nodes at the "
                 f"end of the ramp ({res.parameter[-1]:.4g}), "
@@ -677,6 +723,8 @@ def _lattice_section(
                 **check,
                 unit="1/mm",
                 figure="fig4cf_characteristic_curvature.png",
+                physical=_end_physical(res)[0],
+                physical_reason=_end_physical(res)[1],
                 note=why
                 or "√|k1 k2| of the branch-node surface fit at mean edge strain "
                 f"{res.mean_edge_strain[-1]:+.3f}; the paper gives this only as a plot",
@@ -739,10 +787,10 @@ def _lattice_section(
         ax.set_xlabel("mean edge strain (–)")
         ax.set_ylabel("√|k1 k2| (1/mm)")
         got = "" if res is None else f", simulated sign {int(res.gaussian_sign[-1]):+d}"
-        ax.set_title(
-            f"Fig. {panel}: {pattern} pattern (paper: κ_g {'>' if sign > 0 else '<'} 0{got})",
-            fontsize=10,
+        title, colour = _flagged(
+            f"Fig. {panel}: {pattern} pattern (paper: κ_g {'>' if sign > 0 else '<'} 0{got})", res
         )
+        ax.set_title(title, fontsize=10, color=colour)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     fig.subplots_adjust(bottom=0.3, wspace=0.3)  # legends below the axes, clear of the data
@@ -891,12 +939,15 @@ def _markdown(
             conv = "yes" if r["converged"] else "**NO**"
             if r["discretisation_error"] is not None:
                 conv += f" ({r['discretisation_error']:.2g})"
+            predicted = _fmt(r["predicted"])
+            if r.get("physical") is False:
+                predicted += " **NOT PHYSICAL**"
             cells = [
                 r["quantity"],
                 r["condition"],
                 _fmt(r["measured"]),
                 _fmt(r["spread"]),
-                _fmt(r["predicted"]),
+                predicted,
                 _fmt(r["predicted_sd"]),
                 _fmt(r["z"]),
                 _fmt(r["calibration"]),
@@ -929,6 +980,13 @@ def _markdown(
     if summary["not_converged"]:
         lines += ["## NOT converged to 1 %", ""]
         lines += [f"- {m}" for m in summary["not_converged"]] + [""]
+    unphysical = [r for r in rows if r.get("physical") is False and r["predicted"] is not None]
+    if unphysical:
+        lines += ["## NOT PHYSICAL", ""]
+        lines += [
+            f"- {r['quantity']}, {r['condition']}: {r.get('physical_reason') or 'not physical'}"
+            for r in unphysical
+        ] + [""]
     lines += [
         "## Timings",
         "",
@@ -994,7 +1052,7 @@ def prediction_table(rows: list[dict[str, Any]], summary: dict[str, Any]) -> str
         if r["predicted"] is not None and not r["converged"]:
             how += ", NOT converged"
         if r.get("physical") is False:
-            how += ", NOT PHYSICAL (filaments overlap)"
+            how += f", NOT PHYSICAL ({r.get('physical_reason') or 'filaments overlap'})"
         z = "—" if r["z"] is None else f"{r['z']:+.1f}"
         lines.append(
             f"| {r['quantity']} | {r['condition']} | {_pm(r['measured'], r['spread'])} | "
