@@ -12,7 +12,10 @@ from rotomorph.lattice.heating import lattice_gravity
 
 
 def test_contracting_lattice_on_the_floor_jams_instead_of_overlapping():
-    lat = sinusoidal_lattice(n=3, pattern="contracting")
+    """One printed layer (its contact shape is one capsule per segment): kept on the floor it
+    jams flat, and the lowest-energy branch crumples off the floor; a 3-layer stack is
+    tested below."""
+    lat = sinusoidal_lattice(n=3, pattern="contracting", layers=1)
     # the 'swapped' reading keeps this small case fast (10-25 Newton iterations per step)
     free = heat_lattice(lat, steps=4, actuation="swapped")
     kw = dict(steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
@@ -30,6 +33,22 @@ def test_contracting_lattice_on_the_floor_jams_instead_of_overlapping():
     assert best.min_clearance.min() > 0.995
     k = int(np.flatnonzero(best.floor_lift > 2 * lat.radius)[0])
     assert best.lift_energy_gap[k] < 0.0 and best.energy[-1] < res.energy[-1]
+
+
+def test_a_stacked_contracting_lattice_jams_flat_with_its_layers_apart():
+    """The same lattice printed in three layers: its stacks touch layer by layer, no lifted
+    state the probe finds is admissible and lower, and no two layers ever interpenetrate."""
+    lat = sinusoidal_lattice(n=3, pattern="contracting")
+    kw = dict(steps=4, actuation="swapped", floor=True, gravity=lattice_gravity(lat))
+    res = heat_lattice(lat, **kw)
+    assert res.contact is not None and res.contact.stack.count == 3
+    assert res.stack_overlaps is not None and not res.stack_overlaps.any()
+    assert all(res.physical)
+    assert res.min_clearance.min() >= 1.0 and res.contacts_active[-1] > 0
+    # the floor lies under the bottom layer of the (perturbed) start: the stack rests on it
+    assert res.contact.floor is not None
+    start = res.states[0].positions[:, 2].min() - 0.6 - 1.005 * lat.radius
+    assert -0.01 < res.contact.floor.height - start < 0.0
 
 
 def test_gravity_on_a_free_lattice_needs_a_floor():

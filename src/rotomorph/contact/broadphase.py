@@ -27,7 +27,7 @@ from numba import njit
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.distance import BOUND_MARGIN
 
-__all__ = ["near_pairs", "near_subset", "within_reach"]
+__all__ = ["near_pairs", "near_subset", "stack_exclusion_masks", "stack_near_pairs", "within_reach"]
 
 
 @njit(cache=True)
@@ -360,4 +360,181 @@ def within_reach(
         np.ascontiguousarray(dist, dtype=float),
         np.ascontiguousarray(move, dtype=float),
         np.ascontiguousarray(reach, dtype=float),
+    )
+
+
+@njit(cache=True)
+def _stack_near_pairs(
+    x0, x1, edges, seg_share, node_share, n_edges, real_keys, part_keys, part_masks
+):  # pragma: no cover - compiled
+    nv = edges.shape[0]
+    layers = nv // n_edges
+    lo, hi, share, axis = _boxes(x0, x1, edges, seg_share, node_share)
+    # each network segment's box: the union of its layers' boxes (their end points' boxes lie
+    # inside), with the largest share
+    rlo = np.empty((n_edges, 3))
+    rhi = np.empty((n_edges, 3))
+    rshare = np.zeros(n_edges)
+    for e in range(n_edges):
+        for k in range(3):
+            rlo[e, k] = np.inf
+            rhi[e, k] = -np.inf
+        for m in range(layers):
+            a = m * n_edges + e
+            for k in range(3):
+                rlo[e, k] = min(rlo[e, k], lo[a, k])
+                rhi[e, k] = max(rhi[e, k], hi[a, k])
+            rshare[e] = max(rshare[e], share[a], share[nv + 2 * a], share[nv + 2 * a + 1])
+    raxis = 0
+    widest = -1.0
+    for k in range(3):
+        w = rlo[:, k].max() - rlo[:, k].min()
+        if w > widest:
+            widest, raxis = w, k
+    start = np.empty(n_edges)
+    for e in range(n_edges):
+        start[e] = rlo[e, raxis] - rshare[e]
+    order = np.argsort(start)
+    ptr, partner = _partners(real_keys, n_edges)
+    stamp = np.full(n_edges, -1, dtype=np.int64)
+    # the partly excluded pairs: each segment's partners and their masks (bit k * N + l set:
+    # layer k of the lower segment and layer l of the higher may not touch)
+    pptr, ppartner = _partners(part_keys, n_edges)
+    pmask = np.empty(ppartner.shape[0], dtype=np.int64)
+    fill = pptr[:-1].copy()
+    for t in range(part_keys.shape[0]):
+        a = part_keys[t] // n_edges
+        b = part_keys[t] - a * n_edges
+        pmask[fill[a]] = part_masks[t]
+        fill[a] += 1
+        pmask[fill[b]] = part_masks[t]
+        fill[b] += 1
+    pstamp = np.full(n_edges, -1, dtype=np.int64)
+    mask_of = np.zeros(n_edges, dtype=np.int64)
+    seg = np.empty((max(4 * nv, 16), 2), dtype=np.int64)
+    node = np.empty((max(4 * nv, 16), 2), dtype=np.int64)
+    ns = np.int64(0)
+    nq = np.int64(0)
+    for ii in range(n_edges):
+        e = order[ii]
+        end = rhi[e, raxis] + rshare[e]
+        marked = False
+        for jj in range(ii + 1, n_edges):
+            f = order[jj]
+            if start[f] > end:
+                break
+            if not _boxes_near(rlo, rhi, rshare, e, f):
+                continue
+            if not marked:
+                _mark(stamp, ii, e, ptr, partner)
+                for t in range(pptr[e], pptr[e + 1]):
+                    pstamp[ppartner[t]] = ii
+                    mask_of[ppartner[t]] = pmask[t]
+                marked = True
+            if stamp[f] == ii:
+                continue  # every layer pair of the two segments is excluded
+            mask = mask_of[f] if pstamp[f] == ii else 0
+            # the layer pairs: the tests of _near_pairs on the layer network's own boxes; an
+            # end point's box lies inside its layer's (same share), so it is near another
+            # layer only if its layer is
+            for m in range(layers):
+                a = m * n_edges + e
+                for q in range(layers):
+                    bit = m * layers + q if e < f else q * layers + m
+                    if (mask >> bit) & 1:
+                        continue
+                    b = q * n_edges + f
+                    if not (
+                        _in_window(lo, hi, share, a, b, axis) and _boxes_near(lo, hi, share, a, b)
+                    ):
+                        continue
+                    seg = _grow(seg, ns)
+                    seg[ns, 0] = min(a, b)
+                    seg[ns, 1] = max(a, b)
+                    ns += 1
+                    for side in range(2):
+                        own, other = (a, b) if side == 0 else (b, a)
+                        for end_ in range(2):
+                            v = 2 * own + end_
+                            if _in_window(lo, hi, share, nv + v, other, axis) and _boxes_near(
+                                lo, hi, share, nv + v, other
+                            ):
+                                node = _grow(node, nq)
+                                node[nq, 0] = v
+                                node[nq, 1] = other
+                                nq += 1
+    return seg[:ns].copy(), node[:nq].copy()
+
+
+def stack_exclusion_masks(
+    excluded: IntArray, n_edges: int, layers: int
+) -> tuple[IntArray, IntArray, IntArray]:
+    """The layer network's excluded keys (``a * V + b``, ``V = N E``) seen per network segment
+    pair: the sorted keys ``e * E + f`` (``e < f``) of the pairs whose layer pairs are all
+    excluded, and of those only partly excluded with a bit mask each (bit ``k N + l``: layer
+    k of e and layer l of f may not touch). Pairs of one segment are left out (never
+    proposed)."""
+    if layers * layers > 63:
+        raise ValueError(f"at most 7 layers fit a 64-bit mask; got {layers}")
+    nv = n_edges * layers
+    a, b = excluded // nv, excluded % nv
+    sa, sb = a % n_edges, b % n_edges
+    ka, kb = a // n_edges, b // n_edges
+    keep = sa != sb
+    sa, sb, ka, kb = sa[keep], sb[keep], ka[keep], kb[keep]
+    lo_first = sa < sb
+    e, f = np.where(lo_first, sa, sb), np.where(lo_first, sb, sa)
+    k, m = np.where(lo_first, ka, kb), np.where(lo_first, kb, ka)
+    key = e * n_edges + f
+    bits = np.left_shift(np.int64(1), (k * layers + m).astype(np.int64))
+    uniq, inv = np.unique(key, return_inverse=True)
+    masks = np.zeros(len(uniq), dtype=np.int64)
+    np.bitwise_or.at(masks, inv, bits)
+    full = masks == (1 << (layers * layers)) - 1
+    return (
+        uniq[full].astype(np.int64),
+        uniq[~full].astype(np.int64),
+        masks[~full].astype(np.int64),
+    )
+
+
+def stack_near_pairs(
+    x0: FloatArray,
+    x1: FloatArray,
+    edges: IntArray,
+    seg_share: FloatArray,
+    node_share: FloatArray,
+    *,
+    n_edges: int,
+    masks: tuple[IntArray, IntArray, IntArray],
+) -> tuple[IntArray, IntArray]:
+    """:func:`near_pairs` of a layer network (:mod:`rotomorph.contact.stack`: segment
+    ``v = k E + e`` is layer k of network segment e, its end points ``2 v`` and ``2 v + 1``),
+    found through the network's segments: a sweep over each segment's box around all its
+    layers proposes segment pairs (``real_excluded``: the pairs of which every layer pair is
+    excluded), and each proposed pair's layer pairs and their end points get the tests of
+    :func:`near_pairs` on their own boxes. The same pairs as :func:`near_pairs` on the layer
+    network (a layer's box lies inside its segment's, with no larger share), in another
+    order, at a cost that grows with the network rather than with its layers.
+
+    Parameters
+    ----------
+    x0, x1, edges, seg_share, node_share
+        As for :func:`near_pairs`, of the layer network.
+    n_edges
+        Segments of the network E.
+    masks
+        The layer network's exclusion per segment pair (:func:`stack_exclusion_masks`).
+    """
+    full, part, bits = masks
+    return _stack_near_pairs(  # type: ignore[no-any-return]
+        np.ascontiguousarray(x0, dtype=float),
+        np.ascontiguousarray(x1, dtype=float),
+        np.ascontiguousarray(edges, dtype=np.int64),
+        np.ascontiguousarray(seg_share, dtype=float),
+        np.ascontiguousarray(node_share, dtype=float),
+        int(n_edges),
+        np.ascontiguousarray(full, dtype=np.int64),
+        np.ascontiguousarray(part, dtype=np.int64),
+        np.ascontiguousarray(bits, dtype=np.int64),
     )

@@ -24,7 +24,7 @@ is exact).
 from __future__ import annotations
 
 import weakref
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,6 +43,7 @@ from rotomorph.contact.distance import (
 from rotomorph.contact.exclusion import excluded_pairs
 from rotomorph.contact.friction import FrictionLag, friction_energy
 from rotomorph.contact.obstacles import Cylinder, Floor, Obstacle, Sphere
+from rotomorph.contact.stack import Stack
 from rotomorph.design.network import Network
 from rotomorph.errors import InvalidParameterError
 
@@ -120,6 +121,11 @@ class Contact:
         None: lagged at the solve's initial state, which is also the start. A heating ramp
         passes the lag re-evaluated at the last solution, with the step's start kept, until
         it no longer changes (:func:`rotomorph.lattice.heating.heat_lattice`).
+    stack
+        The shape each segment presents: one capsule of ``radius`` on the centre line
+        (default), or a printed stack of layers of that radius offset along the segment's
+        material director (:class:`~rotomorph.contact.stack.Stack`; bound by
+        :class:`~rotomorph.contact.stacked.StackedContact`).
     """
 
     radius: float | Sequence[float] | FloatArray
@@ -133,6 +139,7 @@ class Contact:
     friction: float = 0.0
     slip: float | None = None
     friction_lag: FrictionLag | None = field(default=None, repr=False, compare=False)
+    stack: Stack = field(default_factory=Stack)
     _radius: FloatArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -177,6 +184,10 @@ class Contact:
                 "Contact.friction_lag",
                 "must be a FrictionLag of these settings (ContactPotential.lag) and needs "
                 "friction > 0; None lags at the initial state",
+            )
+        if not isinstance(self.stack, Stack):
+            raise InvalidParameterError(
+                "Contact.stack", f"must be a rotomorph.contact.stack.Stack; got {self.stack!r}"
             )
 
     def radii(self, n_edges: int) -> FloatArray:
@@ -299,11 +310,33 @@ class ContactPotential:
         The printed network (its node positions decide the fused pairs).
     force_scale
         Typical nodal force (N) used for the default stiffness.
+    excluded
+        Sorted keys of the segment pairs that never touch; default
+        :func:`~rotomorph.contact.exclusion.excluded_pairs` of the network (a network of layer
+        capsules passes its stack's, :func:`~rotomorph.contact.stack.stack_exclusion`).
+    broad_phase
+        The broad phase of the network's own pairs, with the arguments and results of
+        :func:`~rotomorph.contact.broadphase.near_pairs` (the default); a layer network passes
+        :func:`~rotomorph.contact.broadphase.stack_near_pairs`, the same pairs found faster.
     """
 
-    def __init__(self, contact: Contact, network: Network, force_scale: float = 1.0) -> None:
+    def __init__(
+        self,
+        contact: Contact,
+        network: Network,
+        force_scale: float = 1.0,
+        excluded: IntArray | None = None,
+        broad_phase: Callable[..., tuple[IntArray, IntArray]] | None = None,
+    ) -> None:
+        if not contact.stack.is_single:
+            raise InvalidParameterError(
+                "Contact.stack",
+                "a stack of layers is bound by rotomorph.contact.stacked.StackedContact "
+                "(it needs the segments' material frames)",
+            )
         self.contact = contact
         self.network = network
+        self._near = near_pairs if broad_phase is None else broad_phase
         edges = np.ascontiguousarray(network.edges, dtype=np.int64)
         self.edges = edges
         n, ne = network.n_nodes, network.n_edges
@@ -329,11 +362,12 @@ class ContactPotential:
                 f"below the smallest radius {float(self.radius.min()):.4g} mm",
             )
         self.slip = float(contact.slip or 1e-3 * dmin_small)
-        self.excluded = (
-            _excluded(network, edges, self.radius, self.dhat, contact.reach)
-            if contact.self_contact
-            else np.zeros(0, dtype=np.int64)
-        )
+        if excluded is not None:
+            self.excluded = np.ascontiguousarray(excluded, dtype=np.int64)
+        elif contact.self_contact:
+            self.excluded = _excluded(network, edges, self.radius, self.dhat, contact.reach)
+        else:
+            self.excluded = np.zeros(0, dtype=np.int64)
         pts: list[tuple[float, float, float]] = []
         kinds: list[tuple[str, Sphere | Cylinder]] = []
         for o in contact.obstacles:
@@ -373,12 +407,12 @@ class ContactPotential:
         self._pad = PAD * dmin_small
         deg = np.bincount(edges.ravel(), minlength=n)
         inc = -np.ones((n, max(int(deg.max()), 1)), dtype=np.int64)
-        fill = np.zeros(n, dtype=np.int64)
-        for j, (a, b) in enumerate(edges):
-            inc[a, fill[a]] = j
-            fill[a] += 1
-            inc[b, fill[b]] = j
-            fill[b] += 1
+        # each node's segments in the order they appear in ``edges`` (a stable sort by node)
+        flat = edges.ravel()
+        order = np.argsort(flat, kind="stable")
+        at = flat[order]
+        first = np.concatenate([[0], np.cumsum(deg)[:-1]])
+        inc[at, np.arange(len(flat)) - first[at]] = order // 2
         self._incident = inc  # segments at each node, -1 padded
 
     # ------------------------------------------------------------------ friction
@@ -492,7 +526,7 @@ class ContactPotential:
         if not (self.contact.self_contact and len(self.edges) > 1):
             return _NO_PAIRS, _NO_PAIRS
         extra = 0.5 * (self.dhat + margin)
-        return near_pairs(
+        return self._near(
             x0, x1, self.edges, self._incident, self.radius + extra, self.node_radius + extra,
             self.excluded,
         )  # fmt: skip

@@ -46,7 +46,7 @@ from rotomorph.lattice.actuation import (
     get_actuation,
     ramp_value_text,
 )
-from rotomorph.lattice.admissibility import admissibility, overlap_counts
+from rotomorph.lattice.admissibility import admissibility, lattice_stack, overlap_counts
 from rotomorph.lattice.model import LatticeModel, Stiffness, edge_model, lattice_model
 from rotomorph.lattice.paths import (
     SAME_SHAPE_TOL,
@@ -752,9 +752,11 @@ def heat_lattice(
     active = lift = None
     if settings is not None:
         pot = path.final.contact
-        # allowed pairs only (graph neighbours and printed fusions excluded), in r_a + r_b
-        clearance = np.array([pot.clearance(p) for p in positions])
-        active = np.array([pot.active_contacts(p) for p in positions], dtype=np.int64)
+        # allowed pairs only (graph neighbours and printed fusions excluded), in r_a + r_b;
+        # a stacked contact measures its layers (it reads them off the states' frames)
+        where = states if not settings.stack.is_single else positions
+        clearance = np.array([pot.clearance(p) for p in where])
+        active = np.array([pot.active_contacts(p) for p in where], dtype=np.int64)
         if settings.floor is not None:
             lift = np.array([_rise(settings.floor, lattice, p) for p in positions])
     return HeatingResult(
@@ -1188,17 +1190,32 @@ def contact_settings(
     floor: bool | Floor,
     friction: float,
 ) -> Contact | None:
-    """The ramp's contact settings from the ``contact``/``floor``/``friction`` arguments."""
+    """The ramp's contact settings from the ``contact``/``floor``/``friction`` arguments.
+
+    ``contact=True`` (or a floor alone) gives the lattice's printed stack as the contact
+    shape (:func:`rotomorph.lattice.admissibility.lattice_stack`: one capsule per layer), and
+    ``floor=True`` a floor just below its bottom layer; a :class:`Contact` passed in is used as
+    given (with another shape than the stack, a state whose layers interpenetrate is flagged
+    as not admissible)."""
+    stack = lattice_stack(lattice)
     if isinstance(floor, Floor):
         fl: Floor | None = floor
     elif floor:
-        fl = Floor.under(printed, lattice.radius)
+        # under the bottom layer (printed material directors: the sheet normal +z)
+        fl = Floor.under(np.asarray(printed) - [0.0, 0.0, stack.extent], lattice.radius)
     else:
         fl = None
     if isinstance(contact, Contact):
         settings: Contact | None = contact
+        if contact.stack != stack:
+            logger.warning(
+                "contact: the segments present %d capsule(s), the printed stack has %d layers; "
+                "states whose layers interpenetrate are flagged as not admissible",
+                contact.stack.count,
+                stack.count,
+            )
     elif contact or fl is not None:
-        settings = Contact(radius=lattice.radius)
+        settings = Contact(radius=lattice.radius, stack=stack)
     else:
         settings = None
     if settings is None:

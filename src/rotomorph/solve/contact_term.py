@@ -22,6 +22,7 @@ from numba.typed import Dict
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.potential import Contact, ContactPotential, HessianBlocks
+from rotomorph.contact.stacked import WIDTH, DofBlocks, StackedContact
 from rotomorph.design.network import Network
 from rotomorph.solve.linalg import BandedMatrix, SparseMatrix
 from rotomorph.solve.sparse_cholesky import Symbolic, analyse_pattern
@@ -29,6 +30,7 @@ from rotomorph.solve.sparse_cholesky import Symbolic, analyse_pattern
 __all__ = ["ContactTerm", "HessianPattern", "banded_to_csc"]
 
 _QUAD = types.UniTuple(types.int64, 4)
+_SQUARE = WIDTH * WIDTH
 _NO_QUADS = np.zeros((0, 4), dtype=np.int64)
 _NO_PAIR = np.zeros((0, 12, 12))
 _NO_KEYS = np.zeros(0, dtype=np.int64)
@@ -65,6 +67,10 @@ class HessianPattern:
 
     def _forget_positions(self) -> None:
         """Empty the remembered data positions of pair blocks (the union changed)."""
+        # the same for the blocks of a stacked contact (generalised coordinates), by block key
+        self._dof_slot_of = Dict.empty(key_type=types.int64, value_type=types.int64)
+        self._dof_slots: IntArray = np.empty((0, _SQUARE), dtype=np.int64)
+        self._dof_used = np.zeros(1, dtype=np.int64)
         # pair (node indices) -> row of self._slots: the data position of each of its 144
         # entries in the loop order of _scatter_blocks (-1: not a free coordinate, -2: not in
         # the pattern)
@@ -76,11 +82,12 @@ class HessianPattern:
         self._slot_nodes = -1  # and the number of network nodes (quads beyond: obstacles)
 
     def add(
-        self, base: sp.csc_matrix, contact: HessianBlocks, coord_reduced: IntArray
+        self, base: sp.csc_matrix, contact: HessianBlocks | DofBlocks, coord_reduced: IntArray
     ) -> SparseMatrix | None:
         """``base + contact`` (``n x n``) on the grown pattern; ``coord_reduced`` maps a node
-        coordinate ``3 i + k`` to its free index (-1: fixed). None when the contact blocks have
-        no non-zero entry on free coordinates."""
+        coordinate ``3 i + k`` (and, for the :class:`~rotomorph.contact.stacked.DofBlocks` of a
+        stacked contact, the twist angle ``3 N + e``) to its free index (-1: fixed). None when
+        the contact blocks have no non-zero entry on free coordinates."""
         n = base.shape[0]
         if self._n != n:
             self._reset(n)
@@ -91,15 +98,26 @@ class HessianPattern:
             if not self._known_base(base):
                 self._grow(base, np.zeros(0, dtype=np.int64), n, base_known=False)
         assert self._union is not None
-        blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
         cdata = np.zeros(len(self._keys))
-        count = self._scatter(coord_reduced, contact, cdata)
-        if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
-            keys = np.empty(144 * len(contact.quads) + 9 * len(contact.nodes), dtype=np.int64)
-            found = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, keys)
-            self._grow(base, np.unique(keys[:found]), n, base_known=True)
-            cdata = np.zeros(len(self._keys))
+        if isinstance(contact, DofBlocks):
+            count = self._scatter_dofs(coord_reduced, contact, cdata)
+            if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
+                keys = np.empty(_SQUARE * len(contact.keys), dtype=np.int64)
+                found = _dof_keys(
+                    n, coord_reduced, contact.dofs, np.ascontiguousarray(contact.blocks), keys
+                )
+                self._grow(base, np.unique(keys[:found]), n, base_known=True)
+                cdata = np.zeros(len(self._keys))
+                count = self._scatter_dofs(coord_reduced, contact, cdata)
+        else:
             count = self._scatter(coord_reduced, contact, cdata)
+            if count < 0:  # a coupling the pattern does not hold yet: grow by all of them
+                blocks = (contact.n_nodes, contact.quads, contact.pair, contact.nodes, contact.node)
+                keys = np.empty(144 * len(contact.quads) + 9 * len(contact.nodes), dtype=np.int64)
+                found = _scatter_blocks(*self._union[::-1], coord_reduced, *blocks, cdata, keys)
+                self._grow(base, np.unique(keys[:found]), n, base_known=True)
+                cdata = np.zeros(len(self._keys))
+                count = self._scatter(coord_reduced, contact, cdata)
         if count == 0:
             return None
         data = cdata
@@ -153,6 +171,33 @@ class HessianPattern:
         )  # fmt: skip
         return -1 if floor < 0 else count + floor
 
+    def _scatter_dofs(self, coord_reduced: IntArray, contact: DofBlocks, out: FloatArray) -> int:
+        """The blocks of a stacked contact into ``out`` through remembered data positions
+        (found once per block key and pattern); -1 when an entry is not in the pattern."""
+        assert self._union is not None
+        indices, indptr = self._union
+        if (
+            self._slot_coords is None
+            or self._slot_nodes != contact.n_nodes
+            or not np.array_equal(self._slot_coords, coord_reduced)
+        ):
+            self._forget_positions()
+            self._slot_coords = coord_reduced.copy()
+            self._slot_nodes = contact.n_nodes
+        need = int(self._dof_used[0]) + len(contact.keys)
+        if need > len(self._dof_slots):
+            rows = max(need, 2 * len(self._dof_slots), 64)
+            grown = np.empty((rows, _SQUARE), dtype=np.int64)
+            grown[: len(self._dof_slots)] = self._dof_slots
+            self._dof_slots = grown
+        return int(
+            _scatter_dof_blocks(
+                indptr, indices, coord_reduced, contact.dofs,
+                np.ascontiguousarray(contact.blocks), contact.keys, out, self._dof_slot_of,
+                self._dof_slots, self._dof_used,
+            )
+        )  # fmt: skip
+
     def _grow(self, base: sp.csc_matrix, ckeys: IntArray, n: int, base_known: bool) -> None:
         """Add the keys ``column * n + row`` of ``base`` (unless ``base_known``: its pattern is
         the one the union holds) and the sorted distinct ``ckeys`` to the union, then
@@ -194,6 +239,9 @@ class HessianPattern:
                 self._slots, self._slot_quads, int(self._used[0]), shift, self._slot_coords,
                 self._slot_nodes, indptr, rows,
             )  # fmt: skip
+            # the stacked contact's blocks find their positions again (a growth is rare)
+            self._dof_slot_of = Dict.empty(key_type=types.int64, value_type=types.int64)
+            self._dof_used[0] = 0
         else:
             self._forget_positions()
         # keep the ordering while the factor stays within REORDER of its size when ordered;
@@ -226,6 +274,11 @@ class ContactTerm:
         The grown sparsity pattern to start from and to update (a :class:`HessianPattern`
         shared by the solves of one network and support set, e.g. the steps of a ramp);
         default: a new one.
+    theta_dof, directors
+        With a stacked contact (``contact.stack`` of more than one layer): layout index of each
+        segment's twist angle ``(E,)`` and the printed material directors m1 ``(E, 3)``; the
+        contact then depends on the twist angles too
+        (:class:`~rotomorph.contact.stacked.StackedContact`).
     """
 
     def __init__(
@@ -236,25 +289,48 @@ class ContactTerm:
         reduced: IntArray,
         force_scale: float,
         pattern: HessianPattern | None = None,
+        theta_dof: IntArray | None = None,
+        directors: FloatArray | None = None,
     ) -> None:
-        self.potential = ContactPotential(contact, network, force_scale=force_scale)
         coord = (pos_dof[:, None] + np.arange(3)).ravel()
-        self._coord_reduced = reduced[coord]  # node coordinate 3i+k -> reduced index or -1
+        self.stacked = not contact.stack.is_single
+        self.potential: ContactPotential | StackedContact
+        if self.stacked:
+            if theta_dof is None or directors is None:
+                raise ValueError("a stacked contact needs the twist angles and directors")
+            self.potential = StackedContact(contact, network, directors, force_scale)
+            coord = np.concatenate([coord, np.asarray(theta_dof, dtype=np.int64)])
+        else:
+            self.potential = ContactPotential(contact, network, force_scale=force_scale)
+        # node coordinate 3i+k (and, stacked, twist angle 3N+e) -> reduced index or -1
+        self._coord_reduced = np.ascontiguousarray(reduced[coord], dtype=np.int64)
         self._nfree = int((reduced >= 0).sum())
         self.pattern = HessianPattern() if pattern is None else pattern
 
     # ------------------------------------------------------------------ energy
     def evaluate(
-        self, pos: FloatArray, need_grad: bool, need_hess: int
-    ) -> tuple[float, FloatArray | None, HessianBlocks | None]:
-        """Energy, gradient on node coordinates ``(3N,)`` and the Hessian's local blocks."""
+        self,
+        pos: FloatArray,
+        need_grad: bool,
+        need_hess: int,
+        frames: tuple[FloatArray, FloatArray, FloatArray] | None = None,
+    ) -> tuple[float, FloatArray | None, FloatArray | None, HessianBlocks | DofBlocks | None]:
+        """Energy, gradient on node coordinates ``(3N,)`` and on the twist angles ``(E,)``
+        (None without a stacked contact) and the Hessian's local blocks. ``frames``:
+        ``(t, m1, m2)`` of the configuration, needed by a stacked contact."""
+        if isinstance(self.potential, StackedContact):
+            assert frames is not None
+            e, gx, gth, dblocks = self.potential.evaluate_blocks(pos, frames, need_grad, need_hess)
+            if not np.isfinite(e):
+                return np.inf, None, None, None
+            return e, (None if gx is None else gx.ravel()), gth, dblocks
         e, g, blocks = self.potential.evaluate_blocks(pos, need_grad, need_hess)
         if not np.isfinite(e):
-            return np.inf, None, None
-        return e, (None if g is None else g.ravel()), blocks
+            return np.inf, None, None, None
+        return e, (None if g is None else g.ravel()), None, blocks
 
     def add_to(
-        self, rod: BandedMatrix | SparseMatrix, contact: HessianBlocks
+        self, rod: BandedMatrix | SparseMatrix, contact: HessianBlocks | DofBlocks
     ) -> BandedMatrix | SparseMatrix:
         """The rod Hessian plus the contact Hessian on the grown :class:`HessianPattern` (the
         rod Hessian itself when no contact entry falls on free coordinates)."""
@@ -268,12 +344,31 @@ class ContactTerm:
         return self.pattern.analyses
 
     # ------------------------------------------------------------------ steps
-    def step_bound(self, pos: FloatArray, dpos: FloatArray) -> float:
-        """Provably contact-free fraction of the straight step ``pos -> pos + dpos``."""
+    def step_bound(
+        self,
+        pos: FloatArray,
+        dpos: FloatArray,
+        directors: tuple[FloatArray, FloatArray] | None = None,
+    ) -> float:
+        """Provably contact-free fraction of the straight step ``pos -> pos + dpos``;
+        ``directors``: m1 at the start and the end of the step (a stacked contact: the layer
+        points' straight path)."""
+        if isinstance(self.potential, StackedContact):
+            assert directors is not None
+            return self.potential.step_bound((pos, directors[0]), (pos + dpos, directors[1]))
         return self.potential.step_bound(pos, dpos)
 
-    def path_is_free(self, start: FloatArray, end: FloatArray) -> bool:
-        """Whether the straight path between two configurations never touches."""
+    def path_is_free(
+        self,
+        start: FloatArray,
+        end: FloatArray,
+        directors: tuple[FloatArray, FloatArray] | None = None,
+    ) -> bool:
+        """Whether the straight path between two configurations never touches
+        (``directors`` as for :meth:`step_bound`)."""
+        if isinstance(self.potential, StackedContact):
+            assert directors is not None
+            return self.potential.path_is_free((start, directors[0]), (end, directors[1]))
         return self.potential.path_is_free(start, end)
 
 
@@ -509,3 +604,78 @@ def _add_at(out, pos, values):  # pragma: no cover - compiled
     """``out[pos] += values`` for distinct positions ``pos``."""
     for k in range(pos.shape[0]):
         out[pos[k]] += values[k]
+
+
+@njit(cache=True)
+def _dof_keys(n, coord_reduced, dofs, blocks, keys):  # pragma: no cover - compiled
+    """Keys ``column * n + row`` of the non-zero free entries of generalised blocks into
+    ``keys``; their number."""
+    count = 0
+    width = dofs.shape[1]
+    for p in range(dofs.shape[0]):
+        for b in range(width):
+            db = dofs[p, b]
+            if db < 0:
+                continue
+            c = coord_reduced[db]
+            if c < 0:
+                continue
+            for a in range(width):
+                da = dofs[p, a]
+                if da < 0:
+                    continue
+                r = coord_reduced[da]
+                if r < 0 or blocks[p, a, b] == 0.0:
+                    continue
+                keys[count] = c * n + r
+                count += 1
+    return count
+
+
+@njit(cache=True)
+def _scatter_dof_blocks(
+    indptr, indices, coord_reduced, dofs, blocks, bkeys, out, slot_of, slots, used
+):  # pragma: no cover - compiled
+    """Add the non-zero free entries of generalised blocks into ``out`` (the data array of the
+    CSC pattern), each block's data positions remembered in ``slots[slot_of[key]]`` (-1: not
+    a free coordinate, -2: not in the pattern); the number added, or -1 when an entry is not
+    in the pattern."""
+    width = dofs.shape[1]
+    count = 0
+    for p in range(dofs.shape[0]):
+        key = bkeys[p]
+        if key in slot_of:
+            slot = slot_of[key]
+        else:
+            slot = used[0]
+            used[0] += 1
+            slot_of[key] = slot
+            e = 0
+            for b in range(width):
+                db = dofs[p, b]
+                c = coord_reduced[db] if db >= 0 else -1
+                pos = -2
+                for a in range(width):
+                    da = dofs[p, a]
+                    r = coord_reduced[da] if da >= 0 else -1
+                    if c < 0 or r < 0:
+                        slots[slot, e] = -1
+                    else:
+                        pos = _find(indices, indptr[c], indptr[c + 1], r, pos)
+                        slots[slot, e] = pos if pos >= 0 else -2
+                    e += 1
+        e = 0
+        for b in range(width):
+            for a in range(width):
+                t = slots[slot, e]
+                e += 1
+                v = blocks[p, a, b]
+                if t == -1 or v == 0.0:
+                    continue
+                if t == -2:
+                    # forget this block's positions: after the growth they are found again
+                    del slot_of[key]
+                    return -1
+                out[t] += v
+                count += 1
+    return count

@@ -16,9 +16,11 @@ import scipy.sparse as sp
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.contact.obstacles import Floor
 from rotomorph.contact.potential import Contact, HessianBlocks, InfeasibleContactError
+from rotomorph.contact.stacked import DofBlocks, StackedContact
 from rotomorph.errors import InvalidParameterError
 from rotomorph.rod.assembly import (
     evaluate_network,
+    material_frames,
     reference_twist,
     scatter_banded,
     scatter_sparse,
@@ -125,7 +127,7 @@ class RodObjective:
         self._setup_matrix(topo)
         self._fixed_mask = fixed
         self._contact: ContactTerm | None = None
-        self._contact_hess: HessianBlocks | None = None
+        self._contact_hess: HessianBlocks | DofBlocks | None = None
         # with friction the floor holds a free body in every direction wherever it touches, and
         # spheres and cylinders hold it in directions that depend on where it touches them: no
         # rigid motion is projected out (one that stays free has zero energy and is handled by
@@ -152,9 +154,18 @@ class RodObjective:
                 ),
                 # one grown Hessian pattern per network and support set (e.g. a whole ramp)
                 pattern=topo.setdefault("contact_pattern", HessianPattern()),
+                # a printed stack: its layers lie along the material director (twist angles)
+                theta_dof=lay.theta,
+                directors=np.asarray(model.directors),
             )
-            self._contact.potential.check_admissible(state.positions, "initial")
-            self._contact.potential.set_lag(state.positions)  # friction lagged per solve
+            # a stacked contact reads the layers off the frames: it takes the state
+            pot = self._contact.potential
+            if isinstance(pot, StackedContact):
+                pot.check_admissible(state, "initial")
+                pot.set_lag(state)  # friction lagged per solve
+            else:
+                pot.check_admissible(state.positions, "initial")
+                pot.set_lag(state.positions)
 
     @property
     def contact(self):  # type: ignore[no-untyped-def]
@@ -257,6 +268,7 @@ class RodObjective:
         u[self._pos_index] = state.positions.ravel()
         u[self._theta_index] = state.theta
         self._u_base = u
+        self._base_m1: FloatArray | None = None  # the base's material directors, when needed
 
     def vector(self, state: State | None = None) -> FloatArray:
         """Free-DOF vector of ``state`` (default: the base)."""
@@ -318,12 +330,15 @@ class RodObjective:
                 raise
             return np.inf, None, None
         if self._contact is not None:
+            # (the frames of this configuration, filled by the network evaluation above)
+            frames = (self._t, self._m1, self._m2) if self._contact.stacked else None
             if not (need_grad or need_hess):
                 # a line-search trial: the straight path from the accepted iterate must be
                 # provably free of contact, else the trial counts as infinite energy
-                if not self._contact.path_is_free(self.base.positions, pos):
+                dirs = (self._base_directors(), self._m1) if frames is not None else None
+                if not self._contact.path_is_free(self.base.positions, pos, dirs):
                     return np.inf, None, None
-            ce, cg, ch = self._contact.evaluate(pos, need_grad, int(need_hess))
+            ce, cg, cth, ch = self._contact.evaluate(pos, need_grad, int(need_hess), frames)
             if not np.isfinite(ce):
                 if need_grad or need_hess:
                     raise InfeasibleContactError(
@@ -333,6 +348,8 @@ class RodObjective:
             energy += ce
             if cg is not None:
                 self._grad[self._pos_index] += cg
+            if cth is not None:  # a stacked contact twists the segments
+                self._grad[self._theta_index] += cth
             self._contact_hess = ch
         return self._finish(u, pos, theta, energy, need_grad, need_hess)
 
@@ -529,10 +546,31 @@ class RodObjective:
         if self._contact is not None:
             du = np.zeros(self.model.layout.count)
             du[self.free] = d
-            pos, _ = self._unpack(q)
+            pos, theta = self._unpack(q)
             dpos = du[self._pos_index].reshape(-1, 3)
-            bound = min(bound, self._contact.step_bound(pos, bound * dpos) * bound)
+            dirs = None
+            if self._contact.stacked:  # the layers' directors at both ends of the step
+                end = self._directors_at(pos + bound * dpos, theta + bound * du[self._theta_index])
+                dirs = (self._directors_at(pos, theta), end)
+            bound = min(bound, self._contact.step_bound(pos, bound * dpos, dirs) * bound)
         return bound
+
+    def _base_directors(self) -> FloatArray:
+        """Material directors m1 of the base ``(E, 3)`` (computed once per base)."""
+        if self._base_m1 is None:
+            self._base_m1 = self.base.material_directors()[0]
+        return self._base_m1
+
+    def _directors_at(self, pos: FloatArray, theta: FloatArray) -> FloatArray:
+        """Material directors m1 ``(E, 3)`` of a configuration (frames transported from the
+        base, as every evaluation takes them)."""
+        ne = len(self._edges)
+        t, d1, m1, m2 = (np.empty((ne, 3)) for _ in range(4))
+        transport_frames(
+            np.ascontiguousarray(pos), self._edges, self.base.tangents, self.base.directors, t, d1
+        )
+        material_frames(t, d1, np.ascontiguousarray(theta, dtype=float), m1, m2)
+        return m1
 
     def _max_edge_rotation(self, d: FloatArray) -> float:
         du = np.zeros(self.model.layout.count)
@@ -550,7 +588,8 @@ class RodObjective:
         pos, theta = self._unpack(q)
         self._evaluate_network(pos, theta, False, 2)
         if self._contact is not None:
-            self._contact_hess = self._contact.evaluate(pos, False, 2)[2]
+            frames = (self._t, self._m1, self._m2) if self._contact.stacked else None
+            self._contact_hess = self._contact.evaluate(pos, False, 2, frames)[3]
         return self._hessian()
 
     def metric(self) -> FloatArray:
