@@ -17,7 +17,25 @@ from rotomorph.lattice.actuation import ProgramActuation
 from rotomorph.lattice.model import lattice_model
 from rotomorph.materials.janus import FilamentSection, unique_rows
 from rotomorph.materials.material import get_material
-from rotomorph.materials.natural import FilamentModel
+from rotomorph.materials.natural import FilamentModel, LayerStack
+
+
+def _sections(lattice: Any) -> list[FilamentSection]:
+    """The sections a lattice's program actuation solves: one layer's, or the stack's two
+    (stacked across the interface normal where it lies in the sheet, along it at flips)."""
+    fm = FilamentModel()
+    mats = (get_material(lattice.active_material), get_material(lattice.passive_material))
+    if lattice.layers == 1:
+        return [fm.section(*mats, lattice.radius, lattice.active_fraction)]
+    return [
+        fm.section(
+            *mats,
+            lattice.radius,
+            lattice.active_fraction,
+            stack=LayerStack(lattice.layers, lattice.layer_height, d),
+        )
+        for d in ((0.0, 1.0), (1.0, 0.0))
+    ]
 
 
 def _natural(
@@ -26,62 +44,66 @@ def _natural(
     memo: bool,
     clear: bool = True,
     every_line: bool = False,
-) -> tuple[Any, list[np.ndarray], int]:
-    """Natural model of an n x n lattice at 150 °C, every state row asked for, rows solved
-    (``clear``: forget what the section remembers first; ``every_line``: evaluate every line's
-    program, also those repeating another line's up to a translation)."""
-    asked: list[np.ndarray] = []
-    solved = [0]
+    layers: int = 3,
+) -> tuple[Any, dict[int, list[np.ndarray]], dict[int, int]]:
+    """Natural model of an n x n lattice at 150 °C, every state row asked for and rows solved,
+    per section (``clear``: forget what the sections remember first; ``every_line``: evaluate
+    every line's program, also those repeating another line's up to a translation)."""
+    asked: dict[int, list[np.ndarray]] = {}
+    solved: dict[int, int] = {}
     natural_strains = FilamentSection.natural_strains
     solve_states = FilamentSection._solve_states
 
     def record(self: FilamentSection, *args: Any) -> tuple[Any, Any, Any]:
         cols = np.broadcast_arrays(*(np.atleast_1d(np.asarray(a, dtype=float)) for a in args))
-        asked.append(np.column_stack(cols) + 0.0)
+        asked.setdefault(id(self), []).append(np.column_stack(cols) + 0.0)
         if memo:
             return natural_strains(self, *args)
-        rows = solve_states(self, asked[-1])  # every row on its own: no deduplication
+        rows = solve_states(self, asked[id(self)][-1])  # every row on its own: no deduplication
         return rows[:, 0], rows[:, 1:3], rows[:, 3]
 
     def count(self: FilamentSection, states: np.ndarray) -> np.ndarray:
-        solved[0] += len(states)
+        solved[id(self)] = solved.get(id(self), 0) + len(states)
         return solve_states(self, states)
 
-    lattice = sinusoidal_lattice(n)
+    lattice = sinusoidal_lattice(n, layers=layers)
     if every_line:
         lattice._cache[("program_groups",)] = [(k, 0) for k in range(len(lattice.line_programs()))]
-    section = FilamentModel().section(
-        get_material(lattice.active_material),
-        get_material(lattice.passive_material),
-        lattice.radius,
-        lattice.active_fraction,
-    )
     if clear:
-        section._solved.clear()  # a section remembers states across calls: start empty
+        for section in _sections(lattice):
+            section._solved.clear()  # a section remembers states across calls: start empty
     monkeypatch.setattr(FilamentSection, "natural_strains", record)
     monkeypatch.setattr(FilamentSection, "_solve_states", count)
     lm = lattice_model(lattice, stiffness="janus")
     model = ProgramActuation().natural(lm, 150.0)
-    return model, asked, solved[0]
+    return model, asked, solved
 
 
-def test_each_distinct_print_state_is_solved_once(monkeypatch: pytest.MonkeyPatch) -> None:
-    _, asked, solved = _natural(monkeypatch, 6, memo=True, every_line=True)
-    # one solve per distinct state over ALL lines and calls
-    assert solved == len(unique_rows(np.concatenate(asked))[0])
-    per_call = sum(len(unique_rows(rows)[0]) for rows in asked)
-    assert solved * 2 < per_call  # deduplicating within each line's call only solves more
-
-
-def test_remembered_states_give_the_same_field_bit_for_bit(
-    monkeypatch: pytest.MonkeyPatch,
+@pytest.mark.parametrize("layers", [1, 3])
+def test_each_distinct_print_state_is_solved_once(
+    monkeypatch: pytest.MonkeyPatch, layers: int
 ) -> None:
-    cached, _, _ = _natural(monkeypatch, 5, memo=True)
+    _, asked, solved = _natural(monkeypatch, 6, memo=True, every_line=True, layers=layers)
+    assert set(solved) <= set(asked)
+    total = per_call = 0
+    for key, rows in asked.items():
+        # one solve per distinct state of each section over ALL lines and calls
+        assert solved.get(key, 0) == len(unique_rows(np.concatenate(rows))[0])
+        total += solved.get(key, 0)
+        per_call += sum(len(unique_rows(r)[0]) for r in rows)
+    assert total * 2 < per_call  # deduplicating within each line's call only solves more
+
+
+@pytest.mark.parametrize("layers", [1, 3])
+def test_remembered_states_give_the_same_field_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch, layers: int
+) -> None:
+    cached, _, _ = _natural(monkeypatch, 5, memo=True, layers=layers)
     monkeypatch.undo()
-    again, _, solved_again = _natural(monkeypatch, 5, memo=True, clear=False)
-    assert solved_again == 0  # every state remembered from the first call
+    again, _, solved_again = _natural(monkeypatch, 5, memo=True, clear=False, layers=layers)
+    assert sum(solved_again.values()) == 0  # every state remembered from the first call
     monkeypatch.undo()
-    direct, _, _ = _natural(monkeypatch, 5, memo=False)
+    direct, _, _ = _natural(monkeypatch, 5, memo=False, layers=layers)
     for name in ("natural_curvature1", "natural_curvature2", "natural_twist", "rest_length"):
         assert np.array_equal(getattr(cached, name), getattr(direct, name)), name
         assert np.array_equal(getattr(again, name), getattr(direct, name)), name

@@ -51,8 +51,8 @@ from rotomorph.errors import InvalidParameterError
 from rotomorph.geometry import curvature_increment, unit
 from rotomorph.lattice.model import LatticeModel, Stiffness
 from rotomorph.materials.natural import (
-    ActuationIncrements,
     FilamentModel,
+    LayerStack,
     actuation_increments,
 )
 from rotomorph.rod.model import Model
@@ -479,8 +479,13 @@ class ProgramActuation:
     Notes
     -----
     The lines are those of :meth:`rotomorph.design.lattices.Lattice.line_programs` (one layer;
-    the stack of printed layers takes them as :mod:`rotomorph.lattice.model` describes). Their
-    increments are the frame-free output of
+    every layer of a stack prints the same program one layer height up). With a stacked model
+    (:attr:`~rotomorph.lattice.model.LatticeModel.stacked`) the increments are those of the
+    fused stack's section under every layer's eigenstrain field
+    (:func:`~rotomorph.materials.stack.stack_section`): the section stacked across the
+    interface normal where it lies in the sheet, along it where it is the sheet normal (flip
+    segments and vertices; in general along the sheet normal as seen in each vertex's
+    interface frame). Their increments are the frame-free output of
     :func:`~rotomorph.materials.natural.actuation_increments`, read in the lattice model's
     frames with :func:`rotomorph.geometry.curvature_increment`, exactly as a single filament
     reads them in its own. Lines whose programs differ only by a translation and a quarter
@@ -505,17 +510,15 @@ class ProgramActuation:
         stretch = np.ones(model.network.n_edges)
         programs = _derived_programs(lm)
         groups = _program_groups(lm)
-        increments: dict[int, ActuationIncrements] = {}  # one per distinct program
+        increments: dict[int, _Increments] = {}  # one per distinct program
         for line, rows, stencils, line_edges, model_edges in _line_stencils(lm):
             rep, turns = groups[line]
             if rep not in increments:
-                increments[rep] = actuation_increments(
-                    programs[rep], temperature=float(parameter), model=fm
-                )
-            inc = increments[rep]
-            vec[stencils] = _turn(inc.curvature[rows], turns)
-            twist[stencils] = inc.twist[rows]
-            stretch[model_edges] = inc.stretch[line_edges]
+                increments[rep] = _increments(lm, programs[rep], float(parameter), fm)
+            curvature, tw_inc, st_inc = increments[rep]
+            vec[stencils] = _turn(curvature[rows], turns)
+            twist[stencils] = tw_inc[rows]
+            stretch[model_edges] = st_inc[line_edges]
         x = model.network.nodes
         te = unit(x[st.nodes[:, 1]] - x[st.nodes[:, 0]])
         tf = unit(x[st.nodes[:, 2]] - x[st.nodes[:, 1]])
@@ -523,11 +526,28 @@ class ProgramActuation:
         dk1, dk2 = curvature_increment(te, tf, m1[st.edge_e], m1[st.edge_f], vec)
         k1, k2, tw = lm.printed
         return model.with_natural(
-            curvature1=k1 + lm.vertical(dk1),
+            # a stacked model's increments are already the stack's (its fused section)
+            curvature1=k1 + (dk1 if lm.stacked else lm.vertical(dk1)),
             curvature2=k2 + dk2,
             twist=tw + twist,
             rest_length=model.network.edge_lengths * stretch,
         )
+
+
+_Increments = tuple[FloatArray, FloatArray, FloatArray]
+
+
+def _increments(
+    lm: LatticeModel, program: Any, temperature: float, fm: FilamentModel
+) -> _Increments:
+    """(curvature vectors, eigen-twists, stretches) of one printed line at ``temperature``:
+    its own section's, or with a stacked model the fused stack's, stacked along the sheet
+    normal at every vertex (:meth:`ProgramActuation.natural`)."""
+    stack = (
+        LayerStack(int(lm.lattice.layers), float(lm.lattice.layer_height)) if lm.stacked else None
+    )
+    inc = actuation_increments(program, temperature=temperature, model=fm, stack=stack)
+    return inc.curvature, inc.twist, inc.stretch
 
 
 def default_stiffness(

@@ -32,7 +32,7 @@ calibrated (:mod:`rotomorph.materials.calibrate`); only the ratio matters for un
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Literal, cast
 
@@ -52,6 +52,7 @@ from rotomorph.materials.process import (
     actuation_fraction,
     dimensionless_rotation,
 )
+from rotomorph.materials.stack import stack_section
 from rotomorph.materials.temperature import (
     active_modulus,
     passive_modulus,
@@ -87,6 +88,54 @@ CALIBRATED_MODULUS_RATIO = CALIBRATED["modulus_ratio"]
 
 def _calibrated_strain_model() -> ActuationStrainModel:
     return _PAPER["strain_model"]  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class LayerStack:
+    """Geometry of a printed stack: ``layers`` layers ``layer_height`` (mm) apart along
+    ``direction`` in the layers' interface frame (:meth:`FilamentModel.section`), or, with
+    ``direction=None``, along the printed sheet's normal +z, whatever the interface's
+    orientation at a vertex (:func:`actuation_increments` then solves each vertex's stack)."""
+
+    layers: int
+    layer_height: float
+    direction: tuple[float, float] | None = None
+
+
+_GroupedSections = list[tuple[Any, FilamentSection]]
+
+
+def _sections_by_stacking(
+    model: FilamentModel,
+    mats: tuple[Material, Material],
+    radius: float,
+    frac: float,
+    temperature: float,
+    stack: LayerStack | None,
+    n: FloatArray,
+    m2: FloatArray,
+) -> _GroupedSections:
+    """The sections of points with interface frames ``(n, m2)`` ``(K, 3)``: one section, or
+    for a stack along +z one per distinct stacking direction (z in the frame; a stack and its
+    mirror image are the same section), with the indices of the points it serves."""
+    active, passive = mats
+    if stack is None or stack.layers <= 1 or stack.direction is not None:
+        return [(slice(None), model.section(active, passive, radius, frac, temperature,
+                                            stack=stack))]  # fmt: skip
+    s = np.column_stack([n[:, 2], m2[:, 2]])
+    s /= np.maximum(np.linalg.norm(s, axis=1), 1e-300)[:, None]
+    mirror = (s[:, 0] < -1e-12) | ((np.abs(s[:, 0]) <= 1e-12) & (s[:, 1] < 0.0))
+    s[mirror] *= -1.0
+    key = np.round(s, 9) + 0.0
+    uniq, inverse = np.unique(key, axis=0, return_inverse=True)
+    out: _GroupedSections = []
+    for g, direction in enumerate(uniq):
+        geo = LayerStack(
+            stack.layers, stack.layer_height, (float(direction[0]), float(direction[1]))
+        )
+        sec = model.section(active, passive, radius, frac, temperature, stack=geo)
+        out.append((np.flatnonzero(inverse.reshape(-1) == g), sec))
+    return out
 
 
 @dataclass(frozen=True)
@@ -238,18 +287,30 @@ class FilamentModel:
         radius: float,
         active_fraction: float,
         temperature: float | None = None,
+        *,
+        stack: LayerStack | None = None,
     ) -> FilamentSection:
-        """The (cached) meshed section for these materials and geometry (at ``temperature``)."""
+        """The (cached) meshed section for these materials and geometry (at ``temperature``);
+        with ``stack``, the fused section of printed layers
+        (:func:`rotomorph.materials.stack.stack_section`)."""
         e_a, e_p = self.moduli(active, passive, temperature)
-        return filament_section(
-            radius,
-            e_a,
-            e_p,
+        common = dict(
             poisson_active=active.poisson_ratio,
             poisson_passive=passive.poisson_ratio,
             active_fraction=active_fraction,
             resolution=self.resolution,
         )
+        if stack is not None and stack.layers > 1:
+            return stack_section(
+                radius,
+                stack.layers,
+                stack.layer_height,
+                e_a,
+                e_p,
+                direction=stack.direction or (0.0, 1.0),
+                **common,  # type: ignore[arg-type]
+            )
+        return filament_section(radius, e_a, e_p, **common)  # type: ignore[arg-type]
 
     def strains(
         self, speed: float | FloatArray, passive: Material
@@ -468,7 +529,7 @@ def _vertex_increments(
     rot: FloatArray,
     radius: float,
     model: FilamentModel,
-    section: FilamentSection,
+    sections: Callable[[FloatArray, FloatArray], _GroupedSections],
     state: tuple[Material, Material, float],
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Curvature vector ``(N-2, 3)``, eigen-twist ``(N-2,)`` and the printed curvature's change of
@@ -482,6 +543,9 @@ def _vertex_increments(
     cells; sampling the edge's mean nozzle angle instead put the active side on top of the
     filament over the whole flip edge, an out-of-plane curvature K_J·h per flip that changed
     the shape with the vertex spacing h.
+
+    ``sections(n, m2)`` gives the sections of vertices with these interface frames (one, or a
+    printed stack's per stacking direction).
     """
     vn = getattr(program, "vertex_interface_normals", None)
     if vn is None:
@@ -492,12 +556,20 @@ def _vertex_increments(
     omega_v = model.director_pitch * omega_v  # the director helix (kinematic: pitch 1)
     active, passive, temperature = state
     e_par, e_perp, eps_p = model.strains_at(speed[1:-1], active, passive, temperature)
-    eps_straight, _, dtau = section.natural_strains(omega_v, e_par, e_perp, eps_p)
     tb = geometry.unit(t[:-1] + t[1:])
     m2 = np.cross(tb, n_v)
-    k0 = printed_curvature(program, section)
+    k0 = printed_curvature(program, radius)
     k0_section = np.column_stack([np.einsum("ij,ij->i", k0, n_v), np.einsum("ij,ij->i", k0, m2)])
-    eps_curved, kappa = section.curved_strains(omega_v, e_par, e_perp, eps_p, k0_section)
+    cols = np.broadcast_arrays(
+        *(np.atleast_1d(np.asarray(a, dtype=float)) for a in (omega_v, e_par, e_perp, eps_p)),
+        np.zeros(len(n_v)),
+    )[:4]
+    eps_straight, dtau = np.empty(len(n_v)), np.empty(len(n_v))
+    eps_curved, kappa = np.empty(len(n_v)), np.empty((len(n_v), 2))
+    for rows, section in sections(n_v, m2):
+        w, ep, et, eq = (c[rows] for c in cols)
+        eps_straight[rows], _, dtau[rows] = section.natural_strains(w, ep, et, eq)
+        eps_curved[rows], kappa[rows] = section.curved_strains(w, ep, et, eq, k0_section[rows])
     vec = kappa[:, :1] * n_v + kappa[:, 1:2] * m2
     if getattr(program, "step_flips", False) and vn is not None and len(vec) > 2:
         # a vertex in the middle of a split step flip (both its edges flip) is the step
@@ -515,7 +587,7 @@ def _vertex_increments(
 CURVATURE_LIMIT = 0.9
 
 
-def printed_curvature(program: Any, section: FilamentSection) -> FloatArray:
+def printed_curvature(program: Any, radius: float | FilamentSection) -> FloatArray:
     """Printed pointwise curvature vectors ``(N-2, 3)`` (1/mm, toward the centre of curvature)
     at the interior vertices of ``program``'s path, for the curved-section correction.
 
@@ -531,7 +603,8 @@ def printed_curvature(program: Any, section: FilamentSection) -> FloatArray:
     vor = 0.5 * (lengths[:-1] + lengths[1:])
     tb = geometry.unit(e[:-1] / lengths[:-1, None] + e[1:] / lengths[1:, None])
     k0 = np.cross(kb, tb) / vor[:, None]
-    size = np.linalg.norm(k0, axis=1) * section.radius
+    r = float(radius.radius if isinstance(radius, FilamentSection) else radius)
+    size = np.linalg.norm(k0, axis=1) * r
     sharp = size > CURVATURE_LIMIT
     if np.any(sharp):
         logger.warning(
@@ -646,12 +719,16 @@ def actuation_increments(
     temperature: float = 175.0,
     *,
     model: FilamentModel | None = None,
+    stack: LayerStack | None = None,
 ) -> ActuationIncrements:
     """Actuation increments of a printed filament at ``temperature`` (°C).
 
     Parameters and errors as :func:`natural_field`. The section quantities (K_J, K_2, Δτ) are
     sampled at the vertices with the vertex's speed and rotation, toward the vertex interface
-    normal (see ``_vertex_increments``); the centre-line strain per edge.
+    normal (see ``_vertex_increments``); the centre-line strain per edge. ``stack``: the
+    program is one of the identical layers of a printed stack, and the increments are the
+    stack's (its fused section, :func:`rotomorph.materials.stack.stack_section`, with every
+    layer's eigenstrain field from this program).
     """
     model = FilamentModel() if model is None else model
     pts, speed, rot, alpha, radius, frac = _program_arrays(program)
@@ -663,18 +740,34 @@ def actuation_increments(
     edge_speed = 0.5 * (speed[:-1] + speed[1:])
     edge_rot = 0.5 * (rot[:-1] + rot[1:])
     omega_star = DIRECTOR_HELIX_SENSE * dimensionless_rotation(edge_rot, edge_speed, radius)
-    # section and free strains at this temperature (moduli and strains: temperature laws)
-    section = model.section(active, passive, radius, frac, temperature)
-    e_par, e_perp, eps_p = model.strains_at(edge_speed, active, passive, temperature)
-    eps_c, _, _ = section.natural_strains(model.director_pitch * omega_star, e_par, e_perp, eps_p)
     d1 = geometry.space_parallel_directors(pts)
     t = geometry.unit(np.diff(pts, axis=0))
     normals = geometry.rotate_about_tangent(d1, t, alpha)
     vn = getattr(program, "vertex_interface_normals", None)
     if getattr(program, "step_flips", False) and vn is not None:
         normals = _step_flip_normals(normals, np.asarray(vn, dtype=float), t)
+
+    # section(s) and free strains at this temperature (moduli and strains: temperature laws)
+    def sections(n: FloatArray, m2: FloatArray) -> _GroupedSections:
+        return _sections_by_stacking(
+            model, (active, passive), radius, frac, temperature, stack, n, m2
+        )
+
+    e_par, e_perp, eps_p = model.strains_at(edge_speed, active, passive, temperature)
+    edge_cols = np.broadcast_arrays(
+        *(
+            np.atleast_1d(np.asarray(a, dtype=float))
+            for a in (model.director_pitch * omega_star, e_par, e_perp, eps_p)
+        ),
+        np.zeros(len(t)),
+    )[:4]
+    eps_c = np.empty(len(t))
+    edge_sections = sections(normals, np.cross(t, normals))
+    for rows, sec in edge_sections:
+        eps_c[rows] = sec.natural_strains(*(c[rows] for c in edge_cols))[0]
+    section = edge_sections[0][1]
     vec, dtw, deps = _vertex_increments(
-        program, t, normals, speed, rot, radius, model, section, (active, passive, temperature)
+        program, t, normals, speed, rot, radius, model, sections, (active, passive, temperature)
     )
     measure = model.strain_model.measure
     # the curved-section change of the centre-line strain, from the edge's interior end(s)

@@ -96,15 +96,15 @@ class AxialSection:
     def natural_strain(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
         """ε_c = ∫E ε*_zz dA / A_E (dimensionless); ``(...)`` for values ``(..., Q)``."""
         eps = evaluate(eigenstrain, self.points, self.active)
-        # einsum, not a BLAS product: each field's value does not depend on the others in the
-        # batch (bit for bit), so remembered print states equal freshly evaluated ones
-        return np.einsum("...q,q->...", eps, self.modulus * self.weights) / self.axial_stiffness
+        # not a BLAS product: each field's value does not depend on the others in the batch
+        # (bit for bit), so remembered print states equal freshly evaluated ones
+        return row_contract(eps, self.modulus * self.weights) / self.axial_stiffness
 
     def natural_curvature(self, eigenstrain: Field | FloatArray | float) -> FloatArray:
         """κ̄ = −I_E⁻¹ ∫E ε*_zz (x − c) dA (1/mm), components toward (m1, m2): ``(..., 2)``."""
         eps = evaluate(eigenstrain, self.points, self.active)
         lever = (self.modulus * self.weights)[:, None] * (self.points - self.centroid)
-        moment = np.einsum("...q,qk->...k", eps, lever)  # batch-independent (natural_strain)
+        moment = row_contract(eps, lever)  # batch-independent (natural_strain)
         # float64 inputs give a float64 solution (the stubs only promise "floating")
         return cast(FloatArray, -np.linalg.solve(self.bending_matrix, moment[..., None])[..., 0])
 
@@ -189,6 +189,41 @@ class AxialSection:
         )
         t = np.asarray(transverse, dtype=float)[..., None]
         return eps_c, g - t * k0
+
+
+def row_contract(values: FloatArray, weights: FloatArray) -> FloatArray:
+    """``einsum("...q,q...->...", values, weights)``: each row of ``values`` ``(..., Q)``
+    contracted with ``weights`` ``(Q,)`` or ``(Q, K)``, independent of the other rows.
+
+    NumPy's einsum reduces a row to a scalar in buffers of ``np.getbufsize()`` elements whose
+    split depends on the batch's shape, so beyond that many elements the row's value changes
+    in its last bits with the rows evaluated beside it (measured; a reduction to a vector,
+    ``(Q, K)`` weights, does not); such contractions are summed row by row in a fixed order
+    (compiled). The others keep einsum (bit for bit what they gave before)."""
+    v = np.asarray(values, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    if w.ndim == 2:
+        return np.einsum("...q,qk->...k", v, w)
+    if w.size <= np.getbufsize():
+        return np.einsum("...q,q->...", v, w)
+    flat = np.ascontiguousarray(v.reshape(-1, v.shape[-1]))
+    out = _row_sums(flat, np.ascontiguousarray(w.reshape(len(w), -1)))
+    tail = () if w.ndim == 1 else (w.shape[1],)
+    return out.reshape(v.shape[:-1] + tail)
+
+
+@njit(cache=True)
+def _row_sums(values, weights):  # pragma: no cover - compiled
+    """``(n, K)``: row i is sum_q values[i, q] weights[q, :], summed in the order of q."""
+    n, nq = values.shape
+    k = weights.shape[1]
+    out = np.zeros((n, k))
+    for i in range(n):
+        for q in range(nq):
+            v = values[i, q]
+            for c in range(k):
+                out[i, c] += v * weights[q, c]
+    return out
 
 
 def axial_section(mesh: SectionMesh, modulus: Field | FloatArray | float) -> AxialSection:

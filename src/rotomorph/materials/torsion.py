@@ -28,7 +28,7 @@ from scipy.sparse.linalg import spsolve
 from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.mesh import SectionMesh
-from rotomorph.materials.section import Field, evaluate
+from rotomorph.materials.section import Field, evaluate, row_contract
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,7 +58,9 @@ class TorsionSection:
             raise InvalidParameterError(
                 "eigenshear", f"must be finite with trailing shape {self.twist_weights.shape}"
             )
-        return np.einsum("...qi,qi->...", g, self.twist_weights)
+        # (row by row in a fixed order beyond einsum's buffer: batch-independent values)
+        q2 = g.shape[-2] * g.shape[-1]
+        return row_contract(g.reshape(g.shape[:-2] + (q2,)), self.twist_weights.reshape(q2))
 
 
 def _gradients(mesh: SectionMesh) -> FloatArray:
