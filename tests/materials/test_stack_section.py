@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -61,7 +63,7 @@ def test_fusing_adds_torsion_and_the_mesh_converges() -> None:
         for h in (0.6, 0.55, 0.5, 0.4)
     ]
     assert ratio[0] == pytest.approx(1.0, abs=2e-4)
-    assert all(b > a for a, b in zip(ratio, ratio[1:], strict=False))
+    assert all(b > a for a, b in itertools.pairwise(ratio))
     assert 1.25 < ratio[2] < 1.4
     c = [stack_section(R, 3, 0.5, EA, EP, resolution=k).twist_stiffness for k in (32, 96, 192)]
     assert abs(c[1] - c[2]) < 0.01 * c[2] and abs(c[1] - c[2]) < 0.5 * abs(c[0] - c[2])

@@ -60,7 +60,7 @@ class TorsionSection:
             )
         # (row by row in a fixed order beyond einsum's buffer: batch-independent values)
         q2 = g.shape[-2] * g.shape[-1]
-        return row_contract(g.reshape(g.shape[:-2] + (q2,)), self.twist_weights.reshape(q2))
+        return row_contract(g.reshape((*g.shape[:-2], q2)), self.twist_weights.reshape(q2))
 
 
 def _gradients(mesh: SectionMesh) -> FloatArray:
