@@ -13,7 +13,7 @@ def test_a_loop_crosses_itself_a_wave_does_not() -> None:
     s = np.linspace(0.0, 1.0, 40)
     wave = np.column_stack([s, 0.2 * np.sin(2 * np.pi * s)])
     assert not crosses_itself(wave)
-    t = np.linspace(0.0, 2.5 * np.pi, 60)
+    t = np.linspace(0.0, 3.2 * np.pi, 80)
     loop = np.column_stack([0.3 * np.cos(t) + 0.01 * t, 0.3 * np.sin(t)])
     assert crosses_itself(loop)
     assert not crosses_itself(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))  # a corner
