@@ -1,10 +1,14 @@
 """Contact benchmark: heating ramps and rods with contact switched on (JSON lines on stdout).
 
 One line per case with ``case``, ``n_nodes``, ``wall_s``, ``cpu_s`` (this process's CPU time:
-the cost on one core, whatever the load), ``newton_iterations``,
+the cost on one core, whatever the load; with ``--repeat k`` the median of k runs, and
+``cpu_best_s`` the least), ``newton_iterations``,
 ``min_clearance_ratio`` (smallest centre-line distance over ``r_a + r_b`` of the pairs allowed
-to touch, over every ramp step), ``contacts_active`` (at the end), ``stable`` and, for
-lattices, ``area_ratio`` and ``gaussian_sign``:
+to touch, over every ramp step), ``contacts_active`` (at the end), ``stable``,
+``stack_overlaps`` (interpenetrating layer pairs of the printed stack, or of the filament's
+one layer, over every step: must be 0), ``contact_distance_ratio`` (median distance over
+``r_a + r_b`` of the pairs and floor points carrying force at the end: the contact's thickness
+bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
 
 * ``contracting-5x5``, ``dome-5x5``, ``saddle-5x5``: the paper's 5 x 5 lattices, 16-step ramp
   to full actuation, resting on the bath floor under their buoyant weight (silicone oil at
@@ -19,8 +23,9 @@ lattices, ``area_ratio`` and ``gaussian_sign``:
 * ``contact-overhead``: wall (and CPU) time of the expanding 5 x 5 ramp with contact on / off,
   best of two alternating runs each after a warm-up run.
 
-Run: ``python benchmarks/contact.py [--quick] [CASE ...]`` (``--quick``: 4-step ramps; cases
-by name, default all).
+Run: ``python benchmarks/contact.py [--quick] [--repeat K] [CASE ...]`` (``--quick``: 4-step
+ramps; cases by name, default all). The lattices present their printed stack to contact (one
+capsule per layer, three layers).
 """
 
 from __future__ import annotations
@@ -49,11 +54,35 @@ def _stable(res) -> bool | None:  # type: ignore[no-untyped-def]
     return bool(all(flags)) if flags else None
 
 
-def lattice_case(pattern: str, steps: int) -> dict:
+def _contact_ratio(pot, where) -> float | None:  # type: ignore[no-untyped-def]
+    """Median ``d / (r_a + r_b)`` of the pairs (and floor points) carrying force at ``where``."""
+    d, dmin = pot.distances(where)
+    active = d < dmin + pot.dhat
+    return round(float(np.median(d[active] / dmin[active])), 5) if active.any() else None
+
+
+def _bound(res):  # type: ignore[no-untyped-def]
+    """The ramp's contact settings bound to its lattice (distances only: any stiffness)."""
+    from rotomorph.contact.stacked import StackedContact
+
+    net = res.lattice.network
+    up = np.tile([0.0, 0.0, 1.0], (net.n_edges, 1))  # the lattice's printed directors
+    if res.contact.stack.is_single:
+        from rotomorph.contact import ContactPotential
+
+        return ContactPotential(res.contact, net)
+    return StackedContact(res.contact, net, up)
+
+
+def lattice_case(pattern: str, steps: int, repeat: int = 1) -> dict:
     lat = sinusoidal_lattice(pattern=pattern)
-    c0, t0 = time.process_time(), time.perf_counter()
-    res = heat_lattice(lat, steps=steps, floor=True, gravity=lattice_buoyancy(lat))
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    cpus, walls = [], []
+    for _ in range(repeat):
+        c0, t0 = time.process_time(), time.perf_counter()
+        res = heat_lattice(lat, steps=steps, floor=True, gravity=lattice_buoyancy(lat))
+        walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    wall, cpu = float(np.median(walls)), float(np.median(cpus))
     row = {
         "case": f"{pattern}-5x5",
         "n_nodes": int(lat.network.n_nodes),
@@ -63,10 +92,15 @@ def lattice_case(pattern: str, steps: int) -> dict:
         "actuation": res.actuation,
         "wall_s": round(wall, 3),
         "cpu_s": round(cpu, 3),
+        "cpu_best_s": round(min(cpus), 3),
+        "repeats": repeat,
+        "layers": int(lat.layers),
         "newton_iterations": int(res.total_iterations),
         "min_clearance_ratio": round(float(res.min_clearance.min()), 5),
         "contacts_active": int(res.contacts_active[-1]),
         "stable": _stable(res),
+        "stack_overlaps": int(np.max(res.stack_overlaps)),  # type: ignore[arg-type]
+        "contact_distance_ratio": _contact_ratio(_bound(res), res.states[-1]),
         "area_ratio": round(float(res.area_ratio[-1]), 4),
         "gaussian_sign": int(res.gaussian_sign[-1]),
         "max_halvings": int(res.halvings.max()),
@@ -87,6 +121,10 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
     from rotomorph.design.network import Network
 
     pot = ContactPotential(contact, Network.chain(np.asarray(program.points, float)))
+    overlaps = 0
+    for p in sim.positions:  # one layer: the allowed pairs closer than r_a + r_b
+        d, dmin = pot.distances(p)
+        overlaps = max(overlaps, int(np.count_nonzero(d < dmin)))
     return {
         "case": case,
         "n_nodes": len(sim.printed),
@@ -97,6 +135,8 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
         "min_clearance_ratio": round(min(pot.clearance(p) for p in sim.positions), 5),
         "contacts_active": int(pot.active_contacts(sim.positions[-1])),
         "stable": _stable(sim),
+        "stack_overlaps": overlaps,
+        "contact_distance_ratio": _contact_ratio(pot, sim.positions[-1]),
         "end_to_end_ratio": round(float(sim.final_ratio), 4),
     }
 
@@ -123,6 +163,10 @@ def euler_case() -> dict:
         "min_clearance_ratio": round(float(res.contact.clearance(res.positions)), 5),
         "contacts_active": int(res.contact.active_contacts(res.positions)),
         "stable": bool(res.stable),
+        "stack_overlaps": int(
+            np.count_nonzero(np.subtract(*res.contact.distances(res.positions)) < 0)
+        ),
+        "contact_distance_ratio": _contact_ratio(res.contact, res.positions),
         "buckled": bool(np.hypot(tip[1], tip[2]) > 0.01 * case.length),
         "tip_lateral_ratio": round(float(np.hypot(tip[1], tip[2]) / case.length), 4),
         "tip_lateral_elastica": round(y_ref, 4),
@@ -163,7 +207,7 @@ def overhead_case(steps: int, repeats: int = 2) -> dict:
     }
 
 
-def main(quick: bool = False, only: tuple[str, ...] = ()) -> None:
+def main(quick: bool = False, only: tuple[str, ...] = (), repeat: int = 1) -> None:
     from rotomorph.io.designfile import Filament
     from rotomorph.simulate.validation import FILAMENT_SPACINGS, sinusoid_filament
 
@@ -176,7 +220,7 @@ def main(quick: bool = False, only: tuple[str, ...] = ()) -> None:
         _emit(overhead_case(steps))
     for pattern in ("contracting", "dome", "saddle"):
         if wanted(f"{pattern}-5x5"):
-            _emit(lattice_case(pattern, steps))
+            _emit(lattice_case(pattern, steps, repeat))
     if wanted("composite-coil"):
         coil = Filament(
             speed=3.0,
@@ -196,4 +240,6 @@ def main(quick: bool = False, only: tuple[str, ...] = ()) -> None:
 
 if __name__ == "__main__":
     args = sys.argv[1:]
-    main(quick="--quick" in args, only=tuple(a for a in args if not a.startswith("--")))
+    k = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 1
+    names = [a for i, a in enumerate(args) if not a.startswith("--") and args[i - 1] != "--repeat"]
+    main(quick="--quick" in args, only=tuple(names), repeat=k)

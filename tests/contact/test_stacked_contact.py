@@ -39,14 +39,16 @@ def _frames(x, theta, t_base, d1_base, edges):  # type: ignore[no-untyped-def]
     return t, m1, np.cross(t, m1)
 
 
-@pytest.fixture
-def stacked_pair(rng):  # type: ignore[no-untyped-def]
+@pytest.fixture(params=[False, True], ids=["pair", "pair-and-floor"])
+def stacked_pair(rng, request):  # type: ignore[no-untyped-def]
     """Two crossing stacks whose layers are inside the activation distance, in a random
-    twisted and bent configuration (not the printed one)."""
+    twisted and bent configuration (not the printed one); with a floor the lower stack's
+    bottom layer rests on it too."""
     net = _crossing(3.0)
     edges = net.edges
     up = np.tile([0.0, 0.0, 1.0], (net.n_edges, 1))
-    contact = Contact(radius=R, stack=STACK, activation_distance=0.05)
+    floor = (Floor(height=-0.6 - R - 0.03),) if request.param else ()
+    contact = Contact(radius=R, stack=STACK, activation_distance=0.05, obstacles=floor)
     pot = StackedContact(contact, net, up, force_scale=1e-3)
     x = _crossing(1.8 + 0.025).nodes + 0.003 * rng.standard_normal((net.n_nodes, 3))
     t0 = unit(x[edges[:, 1]] - x[edges[:, 0]])
@@ -149,16 +151,20 @@ def test_hessian_matches_finite_differences_of_the_gradient(stacked_pair) -> Non
 
 def test_forces_and_moments_balance(stacked_pair) -> None:  # type: ignore[no-untyped-def]
     """The layers of two stacks push each other apart: the contact forces on the rods' nodes
-    sum to zero (no obstacle), and the barrier gradient is invariant to a rigid translation."""
+    and on the floor balance, and the energy is invariant to a rigid translation (without a
+    floor)."""
     pot, x, theta, t0, d1 = stacked_pair
     t, m1, m2 = _frames(x, theta, t0, d1, pot.edges)
     f = pot.forces((x, m1))
-    assert np.abs(f.sum(axis=0)).max() < 1e-9 * np.abs(f).max()
+    floors = pot.obstacle_forces((x, m1))  # what the lattice exerts on the floor, if any
+    total = f.sum(axis=0) + sum(floors, np.zeros(3))
+    assert np.abs(total).max() < 1e-9 * np.abs(f).max()
     n = pot.n_nodes // 2
     assert f[:n, 2].sum() < 0.0 < f[n:, 2].sum()  # the lower rod pushed down, the upper up
-    e0 = pot.evaluate_blocks(x, (t, m1, m2), False, 0)[0]
-    e1 = pot.evaluate_blocks(x + np.array([3.0, -1.0, 2.0]), (t, m1, m2), False, 0)[0]
-    assert e1 == pytest.approx(e0, rel=1e-12)
+    if not floors:
+        e0 = pot.evaluate_blocks(x, (t, m1, m2), False, 0)[0]
+        e1 = pot.evaluate_blocks(x + np.array([3.0, -1.0, 2.0]), (t, m1, m2), False, 0)[0]
+        assert e1 == pytest.approx(e0, rel=1e-12)
 
 
 def test_a_stack_rests_on_its_bottom_layer() -> None:

@@ -92,3 +92,32 @@ def test_layers_that_do_not_touch_are_refused() -> None:
         stack_section(R, 3, 0.61, EA, EP)
     with pytest.raises(InvalidParameterError, match="direction"):
         stack_section(R, 3, 0.6, EA, EP, direction=(0.0, 0.0))
+
+
+@pytest.mark.parametrize("direction", [(0.0, 1.0), (1.0, 0.0)])
+def test_touching_layers_fold_onto_one_layer(direction) -> None:  # type: ignore[no-untyped-def]
+    """Touching identical layers are solved on one layer's quadrature (a third of the work):
+    the same natural strains, curved-bar changes and twist as the whole section's to round-off,
+    and a printed curvature along the stacking direction goes to the whole section."""
+    from rotomorph.materials.stack import FoldedStackSection
+
+    folded = stack_section(R, 3, 0.6, EA, EP, direction=direction)
+    assert isinstance(folded, FoldedStackSection) and folded.full is not None
+    full = folded.full
+    assert 3 * len(folded.axial.points) == len(full.axial.points)
+    rng = np.random.default_rng(5)
+    n = 8
+    states = np.column_stack([
+        0.3 * rng.standard_normal(n), -0.2 + 0.02 * rng.standard_normal(n),
+        0.1 + 0.01 * rng.standard_normal(n), np.full(n, 0.02),
+    ])  # fmt: skip
+    a, b = folded._solve_states(states), full._solve_states(states)
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    across = np.zeros((n, 2))
+    across[:, 0 if direction == (0.0, 1.0) else 1] = 1.5 * rng.standard_normal(n)
+    for k0 in (across, 0.5 * rng.standard_normal((n, 2))):  # perpendicular, then any
+        got = folded.curved_strains(*states.T, k0)
+        want = full.curved_strains(*states.T, k0)
+        for x, y in zip(got, want, strict=True):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-12 * np.abs(y).max())
+    assert folded.twist_stiffness == full.twist_stiffness

@@ -481,35 +481,26 @@ def _pull_gradient(g, edges, t, m1, m2, length, offsets, gx, gth, gsum):  # prag
 
 
 @njit(cache=True)
-def _jacobian(v, edges, t, m1, m2, length, offsets, J):  # pragma: no cover - compiled
-    """J (3, 7) of layer point v on its segment's (x_a, x_b, theta); returns the segment."""
-    ne = edges.shape[0]
-    seg = (v // 2) % ne
-    o = offsets[(v // 2) // ne]
-    end = v % 2
-    inv = o / length[seg]
-    for r in range(3):
-        for c in range(3):
-            tu = inv * t[seg, r] * m1[seg, c]
-            J[r, c] = tu
-            J[r, 3 + c] = -tu
-        J[r, r + 3 * end] += 1.0
-        J[r, 6] = o * m2[seg, r]
-    return seg
-
-
-@njit(cache=True)
 def _pull_pairs(quads, pair, nv, edges, t, m1, m2, length, offsets):  # pragma: no cover
     """J^T H J (14 x 14) of every pair block on the 4 layer points ``quads``: slot 0 holds
     the segment of the first point, slot 1 that of the third (-1: an obstacle, or the same
-    segment, then folded into slot 0)."""
+    segment, then folded into slot 0). A point's Jacobian is the identity on its own node
+    plus rank-one terms (module docstring), so H J and J^T (H J) are formed from H's
+    products with t and m2 instead of dense 3 x 7 blocks."""
+    ne = edges.shape[0]
     n = quads.shape[0]
     seg_a = np.empty(n, dtype=np.int64)
     seg_b = np.empty(n, dtype=np.int64)
     out = np.zeros((n, 14, 14))
-    Js = np.zeros((4, 3, 7))
     slot = np.empty(4, dtype=np.int64)
-    HJ = np.empty((3, 7))
+    seg = np.empty(4, dtype=np.int64)
+    end = np.empty(4, dtype=np.int64)
+    off = np.empty(4)
+    ht = np.empty((4, 12))  # H[:, point i] @ t of i's segment
+    hm = np.empty((4, 12))  # H[:, point i] @ m2
+    HJ = np.empty((12, 14))
+    tj = np.empty((4, 14))  # t . HJ[rows of point i]
+    mj = np.empty((4, 14))  # m2 . HJ[rows of point i]
     for p in range(n):
         sa = -1
         sb = -1
@@ -518,13 +509,16 @@ def _pull_pairs(quads, pair, nv, edges, t, m1, m2, length, offsets):  # pragma: 
             if v >= nv:
                 slot[i] = -1
                 continue
-            s = _jacobian(v, edges, t, m1, m2, length, offsets, Js[i])
+            e = (v // 2) % ne
+            seg[i] = e
+            end[i] = v % 2
+            off[i] = offsets[(v // 2) // ne]
             if sa < 0:
-                sa = s
-            if s == sa:
+                sa = e
+            if e == sa:
                 slot[i] = 0
             else:
-                sb = s
+                sb = e
                 slot[i] = 1
         if sb >= 0 and sb < sa:  # lower segment first
             sa, sb = sb, sa
@@ -536,41 +530,101 @@ def _pull_pairs(quads, pair, nv, edges, t, m1, m2, length, offsets):  # pragma: 
         for i in range(4):
             if slot[i] < 0:
                 continue
-            for j in range(4):
-                if slot[j] < 0:
-                    continue
-                # HJ = H_ij J_j (3 x 7)
+            e = seg[i]
+            for r in range(12):
+                a0 = pair[p, r, 3 * i]
+                a1 = pair[p, r, 3 * i + 1]
+                a2 = pair[p, r, 3 * i + 2]
+                ht[i, r] = a0 * t[e, 0] + a1 * t[e, 1] + a2 * t[e, 2]
+                hm[i, r] = a0 * m2[e, 0] + a1 * m2[e, 1] + a2 * m2[e, 2]
+        # H J: columns (slot s: x_a 0..2, x_b 3..5, theta 6)
+        for r in range(12):
+            for c in range(14):
+                HJ[r, c] = 0.0
+        for i in range(4):
+            if slot[i] < 0:
+                continue
+            e = seg[i]
+            base = 7 * slot[i]
+            s_i = off[i] / length[e]
+            col = base + 3 * end[i]
+            for r in range(12):
+                for c in range(3):
+                    HJ[r, col + c] += pair[p, r, 3 * i + c]
+                    w = s_i * m1[e, c] * ht[i, r]
+                    HJ[r, base + c] += w
+                    HJ[r, base + 3 + c] -= w
+                HJ[r, base + 6] += off[i] * hm[i, r]
+        # J^T (H J)
+        for i in range(4):
+            if slot[i] < 0:
+                continue
+            e = seg[i]
+            for c in range(14):
+                tj[i, c] = (
+                    t[e, 0] * HJ[3 * i, c] + t[e, 1] * HJ[3 * i + 1, c] + t[e, 2] * HJ[3 * i + 2, c]
+                )
+                mj[i, c] = (
+                    m2[e, 0] * HJ[3 * i, c]
+                    + m2[e, 1] * HJ[3 * i + 1, c]
+                    + m2[e, 2] * HJ[3 * i + 2, c]
+                )
+        for i in range(4):
+            if slot[i] < 0:
+                continue
+            e = seg[i]
+            base = 7 * slot[i]
+            s_i = off[i] / length[e]
+            row = base + 3 * end[i]
+            for c in range(14):
                 for r in range(3):
-                    for c in range(7):
-                        acc = 0.0
-                        for m in range(3):
-                            acc += pair[p, 3 * i + r, 3 * j + m] * Js[j, m, c]
-                        HJ[r, c] = acc
-                oi = 7 * slot[i]
-                oj = 7 * slot[j]
-                for r in range(7):
-                    for c in range(7):
-                        acc = 0.0
-                        for m in range(3):
-                            acc += Js[i, m, r] * HJ[m, c]
-                        out[p, oi + r, oj + c] += acc
+                    out[p, row + r, c] += HJ[3 * i + r, c]
+                    w = s_i * m1[e, r] * tj[i, c]
+                    out[p, base + r, c] += w
+                    out[p, base + 3 + r, c] -= w
+                out[p, base + 6, c] += off[i] * mj[i, c]
     return seg_a, seg_b, out
 
 
 @njit(cache=True)
 def _pull_nodes(nodes, node, edges, t, m1, m2, length, offsets):  # pragma: no cover
-    """J^T H J (7 x 7) of the floor blocks (3 x 3) of layer points ``nodes``."""
+    """J^T H J (7 x 7) of the floor blocks (3 x 3) of layer points ``nodes`` (structured as
+    :func:`_pull_pairs`)."""
+    ne = edges.shape[0]
     out = np.zeros((nodes.shape[0], 7, 7))
-    J = np.zeros((3, 7))
+    HJ = np.empty((3, 7))
+    ht = np.empty(3)
+    hm = np.empty(3)
+    tj = np.empty(7)
+    mj = np.empty(7)
     for q in range(nodes.shape[0]):
-        _jacobian(nodes[q], edges, t, m1, m2, length, offsets, J)
-        for r in range(7):
+        v = nodes[q]
+        e = (v // 2) % ne
+        o = offsets[(v // 2) // ne]
+        col = 3 * (v % 2)
+        sc = o / length[e]
+        for r in range(3):
+            ht[r] = node[q, r, 0] * t[e, 0] + node[q, r, 1] * t[e, 1] + node[q, r, 2] * t[e, 2]
+            hm[r] = node[q, r, 0] * m2[e, 0] + node[q, r, 1] * m2[e, 1] + node[q, r, 2] * m2[e, 2]
+        for r in range(3):
             for c in range(7):
-                acc = 0.0
-                for a in range(3):
-                    for b in range(3):
-                        acc += J[a, r] * node[q, a, b] * J[b, c]
-                out[q, r, c] = acc
+                HJ[r, c] = 0.0
+            for c in range(3):
+                HJ[r, col + c] += node[q, r, c]
+                w = sc * m1[e, c] * ht[r]
+                HJ[r, c] += w
+                HJ[r, 3 + c] -= w
+            HJ[r, 6] = o * hm[r]
+        for c in range(7):
+            tj[c] = t[e, 0] * HJ[0, c] + t[e, 1] * HJ[1, c] + t[e, 2] * HJ[2, c]
+            mj[c] = m2[e, 0] * HJ[0, c] + m2[e, 1] * HJ[1, c] + m2[e, 2] * HJ[2, c]
+        for c in range(7):
+            for r in range(3):
+                out[q, col + r, c] += HJ[r, c]
+                w = sc * m1[e, r] * tj[c]
+                out[q, r, c] += w
+                out[q, 3 + r, c] -= w
+            out[q, 6, c] += o * mj[c]
     return out
 
 

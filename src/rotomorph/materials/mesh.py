@@ -71,12 +71,17 @@ class SectionMesh:
 
     def quadrature(self) -> tuple[FloatArray, FloatArray, BoolArray, IntArray]:
         """Edge-midpoint quadrature: points ``(3T, 2)`` (mm), weights ``(3T,)`` (mm²),
-        active flags ``(3T,)`` and owning triangle ``(3T,)``; exact for quadratics."""
-        a = self.points[self.triangles]
-        mids = 0.5 * (a + a[:, [1, 2, 0]])
-        w = np.repeat(self.areas / 3.0, 3)
-        owner = np.repeat(np.arange(len(self.triangles)), 3)
-        return mids.reshape(-1, 2), w, np.repeat(self.active, 3), owner
+        active flags ``(3T,)`` and owning triangle ``(3T,)``; exact for quadratics.
+        Computed once per mesh (a value); copies are handed out."""
+        rule = self.__dict__.get("_rule")
+        if rule is None:
+            a = self.points[self.triangles]
+            mids = 0.5 * (a + a[:, [1, 2, 0]])
+            w = np.repeat(self.areas / 3.0, 3)
+            owner = np.repeat(np.arange(len(self.triangles)), 3)
+            rule = (mids.reshape(-1, 2), w, np.repeat(self.active, 3), owner)
+            object.__setattr__(self, "_rule", rule)
+        return tuple(a.copy() for a in rule)  # type: ignore[return-value]
 
 
 def interface_offset(radius: float, active_fraction: float) -> float:

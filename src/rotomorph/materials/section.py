@@ -69,6 +69,10 @@ class AxialSection:
     Build with :func:`axial_section`. Attributes: ``axial_stiffness`` A_E (N), ``centroid`` c
     ``(2,)`` (mm), ``bending_matrix`` I_E ``(2, 2)`` (N·mm²), quadrature ``points`` ``(Q, 2)``
     (mm), ``weights`` ``(Q,)`` (mm²), ``active`` ``(Q,)`` and ``modulus`` E at the points (MPa).
+    ``folded_moment`` ``(2, 2)`` (mm², default none): the quadrature stands for several copies
+    of itself shifted along directions that add ``Σ w · folded_moment`` to the second moment
+    of every weight w (identical layers of a stack, :mod:`rotomorph.materials.stack`); the
+    stiffnesses given are the whole section's.
     """
 
     axial_stiffness: float
@@ -78,6 +82,7 @@ class AxialSection:
     weights: FloatArray
     active: BoolArray
     modulus: FloatArray
+    folded_moment: FloatArray | None = None
 
     @property
     def bending_stiffness1(self) -> float:
@@ -181,6 +186,8 @@ class AxialSection:
             raise InvalidParameterError(
                 "curvature", "printed radius of curvature is smaller than the section's extent"
             )
+        if self.folded_moment is not None:  # the copies' shifts (class docstring)
+            m[:, 1:, 1:] += m[:, :1, :1] * self.folded_moment
         sol = np.linalg.solve(m, rhs[..., None])[..., 0]
         eps_g, g = sol[..., 0], sol[..., 1:]
         c = self.centroid  # (products written out: a matrix product rounds by batch size)

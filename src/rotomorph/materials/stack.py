@@ -39,7 +39,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 from scipy.spatial import Delaunay
@@ -48,7 +48,8 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
 from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection
 from rotomorph.materials.mesh import SectionMesh, interface_offset
-from rotomorph.materials.section import axial_section, phase_constant
+from rotomorph.materials.section import AxialSection, axial_section, phase_constant
+from rotomorph.materials.torsion import TorsionSection
 
 __all__ = ["StackMesh", "StackSection", "stack_mesh", "stack_section", "touching"]
 
@@ -205,8 +206,9 @@ def stack_mesh(
     centres = offsets[:, None] * s[None, :]
     fused = n_layers > 1 and not touching(radius, layer_height)
     pieces: list[tuple[FloatArray, int, bool]] = []
-    for k in range(n_layers):
-        poly = centres[k] + circle
+    for k in range(n_layers if fused else 1):  # touching layers: translates of one layer
+        centre = centres[k] if fused else np.zeros(2)
+        poly = centre + circle
         if fused and k < n_layers - 1:  # split the lens with the next layer at its middle
             poly = _clip(poly, s, float(s @ centres[k]) + 0.5 * layer_height)
         if fused and k > 0:
@@ -215,19 +217,21 @@ def stack_mesh(
             pieces.append((_ccw(poly), k, True))
             continue
         e1 = np.array([1.0, 0.0])
-        level = float(e1 @ centres[k]) + d
+        level = float(e1 @ centre) + d
         pieces.append((_ccw(_clip(poly, -e1, -level)), k, True))  # x1 >= c1 + d: active
         pieces.append((_ccw(_clip(poly, e1, level)), k, False))
     corners = np.vstack([p for p, _, _ in pieces])
+    meshed = [(_piece_mesh(poly, corners, spacing, tol), k, act) for poly, k, act in pieces
+              if len(poly) >= 3]  # fmt: skip
+    if not fused:  # every layer the same triangles in the same order, moved to its centre
+        meshed = [((pts + centres[k], tri), k, act) for k in range(n_layers)
+                  for (pts, tri), _, act in meshed]  # fmt: skip
     points: list[FloatArray] = []
     tris: list[IntArray] = []
     layer_of: list[IntArray] = []
     flags: list[np.ndarray] = []
     base = 0
-    for poly, k, is_active in pieces:
-        if len(poly) < 3:
-            continue
-        pts, tri = _piece_mesh(poly, corners, spacing, tol)
+    for (pts, tri), k, is_active in meshed:
         points.append(pts)
         tris.append(tri + base)
         layer_of.append(np.full(len(tri), k))
@@ -265,8 +269,19 @@ class StackSection(FilamentSection):
     layer_height: float = 0.0
     direction: tuple[float, float] = (0.0, 1.0)
 
-    def _local(self) -> FloatArray:
+    @cached_property
+    def _local_points(self) -> FloatArray:
+        """Quadrature points relative to their layer's centre ``(Q, 2)`` (mm)."""
         return self.axial.points - self.centres
+
+    @cached_property
+    def _radial2(self) -> FloatArray:
+        """(r / R)² about each point's layer centre ``(Q,)``."""
+        xy = self._local_points
+        return np.sum(xy * xy, axis=1) / self.radius**2
+
+    def _local(self) -> FloatArray:
+        return self._local_points
 
     def eigenfields(
         self,
@@ -289,10 +304,79 @@ class StackSection(FilamentSection):
     def _axial_eigenstrain(
         self, w: FloatArray, ep: FloatArray, et: FloatArray, eq: FloatArray
     ) -> tuple[FloatArray, FloatArray]:
-        xy, act = self._local(), self.axial.active
-        u2 = np.sum(xy * xy, axis=1) / self.radius**2
-        denom = 1.0 + w * w * u2
+        act = self.axial.active
+        denom = 1.0 + w * w * self._radial2
         return np.where(act, et + (ep - et) / denom, eq), denom
+
+
+@dataclass(frozen=True, eq=False)
+class FoldedStackSection(StackSection):
+    """A stack of touching identical layers solved on one layer's quadrature.
+
+    Layers one diameter apart are translates of one another (meshed as such), and every layer
+    carries the same print state, so the natural-strain functionals of the whole section fold
+    onto one layer's quadrature points: N times its weights, the whole section's stiffnesses,
+    and for the curved bar the layers' shifts as an added second moment (exact where the
+    printed curvature is perpendicular to the stacking direction, as a planar path's is; other
+    curvatures are solved on ``full``). The same values as ``full`` to round-off (tested), a
+    third of the work.
+    """
+
+    full_key: tuple = ()
+
+    @cached_property
+    def full(self) -> StackSection:
+        """The whole (unfolded) section, built on first use (torsion, or a printed curvature
+        along the stacking direction)."""
+        return _full(*self.full_key)
+
+    @cached_property
+    def torsion(self) -> TorsionSection:
+        """The whole section's torsion, its twist weights folded onto one layer."""
+        t = self.full.torsion
+        q1 = len(self.axial.points)
+        weights = t.twist_weights.reshape(self.layers, q1, 2).sum(axis=0)
+        return TorsionSection(t.torsion_constant, t.warping, weights, self.axial.points,
+                              self.axial.active)  # fmt: skip
+
+    def curved_strains(
+        self,
+        omega_star: float | FloatArray,
+        eps_parallel: float | FloatArray,
+        eps_perpendicular: float | FloatArray,
+        eps_passive: float | FloatArray,
+        curvature: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """As :meth:`FilamentSection.curved_strains` (on ``full`` where a printed curvature
+        has a component along the stacking direction)."""
+        k0 = np.asarray(curvature, dtype=float).reshape(-1, 2)
+        s = np.asarray(self.direction)
+        along = np.abs(k0 @ s) > 1e-12 * np.maximum(np.linalg.norm(k0, axis=1), 1e-300)
+        if np.any(along):
+            return self.full.curved_strains(
+                omega_star, eps_parallel, eps_perpendicular, eps_passive, curvature
+            )
+        return super().curved_strains(
+            omega_star, eps_parallel, eps_perpendicular, eps_passive, curvature
+        )
+
+
+@lru_cache(maxsize=16)
+def _mesh(
+    radius: float,
+    layers: int,
+    layer_height: float,
+    active_fraction: float,
+    direction: tuple[float, float],
+    resolution: int,
+) -> tuple[StackMesh, FloatArray]:
+    """The stack's mesh and each quadrature point's layer centre, shared by every modulus pair
+    (the moduli follow the temperature over a ramp; the geometry does not)."""
+    sm = stack_mesh(radius, layers, layer_height, active_fraction, direction, resolution)
+    _, _, _, owner = sm.mesh.quadrature()
+    centres = sm.centres[sm.layer[owner]]
+    centres.setflags(write=False)
+    return sm, centres
 
 
 @lru_cache(maxsize=64)
@@ -308,15 +392,62 @@ def _cached(
     direction: tuple[float, float],
     resolution: int,
 ) -> StackSection:
-    sm = stack_mesh(radius, layers, layer_height, active_fraction, direction, resolution)
-    axial = axial_section(sm.mesh, phase_constant(e_active, e_passive))
-    _, _, _, owner = sm.mesh.quadrature()
-    centres = sm.centres[sm.layer[owner]]
-    centres.setflags(write=False)
+    key = (radius, layers, layer_height, e_active, e_passive, g_active, g_passive,
+           active_fraction, direction, resolution)  # fmt: skip
+    if layers == 1 or not touching(radius, layer_height):
+        return _full(*key)
+    # touching layers: translates of one layer (stack_mesh), folded onto it: N copies of its
+    # quadrature, the bonded beam's stiffnesses (parallel axes, exact for translates)
+    one, _ = _mesh(radius, 1, 0.0, active_fraction, direction, resolution)
+    axial = axial_section(one.mesh, phase_constant(e_active, e_passive))
+    s = np.asarray(direction, dtype=float)
+    offsets = (np.arange(layers) - 0.5 * (layers - 1)) * layer_height
+    moment = float(np.sum(offsets**2))
+    folded = AxialSection(
+        layers * axial.axial_stiffness,
+        axial.centroid,
+        layers * axial.bending_matrix + axial.axial_stiffness * moment * np.outer(s, s),
+        axial.points,
+        layers * axial.weights,
+        axial.active,
+        axial.modulus,
+        folded_moment=moment / layers * np.outer(s, s),
+    )
+    zero = np.zeros((len(axial.points), 2))
+    zero.setflags(write=False)
+    sm, _ = _mesh(radius, layers, layer_height, active_fraction, direction, resolution)
+    return FoldedStackSection(
+        radius,
+        sm.mesh,
+        folded,
+        (g_active, g_passive),
+        centres=zero,
+        layers=layers,
+        layer_height=layer_height,
+        direction=direction,
+        full_key=key,
+    )
+
+
+@lru_cache(maxsize=16)
+def _full(
+    radius: float,
+    layers: int,
+    layer_height: float,
+    e_active: float,
+    e_passive: float,
+    g_active: float,
+    g_passive: float,
+    active_fraction: float,
+    direction: tuple[float, float],
+    resolution: int,
+) -> StackSection:
+    """The whole (unfolded) stack section."""
+    sm, centres = _mesh(radius, layers, layer_height, active_fraction, direction, resolution)
     return StackSection(
         radius,
         sm.mesh,
-        axial,
+        axial_section(sm.mesh, phase_constant(e_active, e_passive)),
         (g_active, g_passive),
         centres=centres,
         layers=layers,
