@@ -906,7 +906,7 @@ def _lift_probe(
     )
     dz = v * (LIFT_PROBE_HEIGHT * lattice.spacing / float(np.abs(v).max()))
     free, spent = _settle_weightless(
-        model, supports, perturbed_state(model, dz, resting.state), options, afloat
+        model, supports, _untouched_lift(model, resting.state, dz, afloat), options, afloat
     )
     if free is None:
         return None, None, spent
@@ -1000,6 +1000,23 @@ def _potential_energy(
     The barrier stiffness follows from the model and loads alone, so it is the ramp's."""
     obj = RodObjective(model, state, supports, loads, contact)
     return float(obj.evaluate(obj.vector(), False, 0)[0])
+
+
+def _untouched_lift(model: Model, state: State, dz: FloatArray, contact: Contact) -> State:
+    """``state`` lifted by ``dz`` (:func:`perturbed_state`), or by the largest of ``dz/2``,
+    ``dz/4`` … (down to ``dz/256``) at which nothing it may touch touches: a jammed lattice
+    lifted along a mode can push the layers of neighbouring stacks into each other (they
+    rest within the activation distance), and a start that touches is refused. The last
+    one tried is returned if none is free (the solve then refuses it)."""
+    lifted = perturbed_state(model, dz, state)
+    for _ in range(8):
+        try:
+            RodObjective(model, lifted, Supports(), Loads(), contact)  # checks the start
+            return lifted
+        except InfeasibleContactError:
+            dz = 0.5 * dz
+            lifted = perturbed_state(model, dz, state)
+    return lifted
 
 
 def _refine_lift_off(

@@ -143,20 +143,33 @@ def lattice_tube_figure(
     k = len(result.positions) - 1
     edges = np.asarray(lattice.network.edges)
     normals = None
+    positions, ghost, drawn = result.positions[k], result.positions[0], edges
+    seg = segment_values(values, edges)
     if result.states:  # the printed interface normals carried with the material frame
         ends = (result.states[0], result.states[k])
         normals = active_normals(ends, interface_normals(lattice))[1][1]
+        if lattice.layers > 1:  # every layer of the printed stack, on its material director
+            from rotomorph.contact.stack import layer_edges, layer_points
+            from rotomorph.lattice.admissibility import lattice_stack
+
+            stack = lattice_stack(lattice)
+            m1 = [s.material_directors()[0] for s in ends]
+            ghost = layer_points(ghost, edges, m1[0], stack.offsets)
+            positions = layer_points(positions, edges, m1[1], stack.offsets)
+            drawn = layer_edges(len(edges), stack.count)
+            normals = np.tile(normals, (stack.count, 1))
+            seg = np.tile(seg, stack.count)
     oblique = TubePanel(
-        positions=result.positions[k],
-        edges=edges,
+        positions=positions,
+        edges=drawn,
         radius=float(lattice.radius),
         normals=normals,
-        title="active and passive halves",
-        ghost=result.positions[0],
+        title="active and passive halves"
+        + (f" ({lattice.layers} layers)" if drawn is not edges else ""),
+        ghost=ghost,
         active_fraction=float(lattice.active_fraction),
     )
     side = replace(oblique, title="side view", view=(4.0, -90.0))
-    seg = segment_values(values, edges)
     field = replace(oblique, values=seg, title="(κ − κ_i)/κ_i")
     return plot_tube_panels(
         [oblique, side, field],
