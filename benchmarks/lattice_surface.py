@@ -1,0 +1,155 @@
+"""Are the heated dome and saddle surfaces? What keeps them from it (JSON lines, a figure).
+
+For the report's contact-resolved dome and saddle ramps (5 x 5, the calibrated model, the
+bath floor under buoyant weight, every edge presenting its printed three-layer stack; the
+same ramps as ``rotomorph paper``, served from its disk cache where it ran), one line per ramp
+step with:
+
+* ``residual_over_rise``: RMS residual of the quadratic fitted to the branch nodes over their
+  rise along its normal, and ``crossing_edges``: lattice edges whose projection onto the
+  fit's plane crosses itself (:mod:`rotomorph.analysis.surface`);
+* the elastic energy by kind (N mm): bending toward the sheet normal (``bend_out``, the stack's
+  stiff direction), in the sheet (``bend_in``), ``twist`` and ``stretch``, each against the
+  natural state of that step;
+* ``roll_deg``: median angle between the material director (printed: the sheet normal) and
+  the fitted surface's normal, on the expanding and on the contracting edges: an edge that
+  has rolled onto its side shows 90°.
+
+``--figure PATH`` draws the residual, the roll and the energy shares over the ramp. Run:
+``python benchmarks/lattice_surface.py [--ghosts G] [--figure PATH]`` (default 20 ghost
+nodes per edge, the report's counted resolution).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from rotomorph.analysis.surface import surface_quality
+from rotomorph.geometry import pair_strains
+from rotomorph.lattice.actuation import ProgramActuation
+from rotomorph.simulate.report import (
+    LATTICE_STEPS,
+    LIFT_OFF_TOLERANCE,
+    PATH_CHECK_FACTOR,
+    _heat,
+    calibrated_model,
+)
+
+
+def energies(model, state) -> dict[str, float]:  # type: ignore[no-untyped-def]
+    """Elastic energy of ``state`` by kind against ``model``'s natural state (N mm)."""
+    st = model.stencils
+    x = state.positions
+    m1, _ = state.material_directors()
+    e = x[st.nodes[:, 1]] - x[st.nodes[:, 0]]
+    f = x[st.nodes[:, 2]] - x[st.nodes[:, 1]]
+    k1, k2, tw = pair_strains(e, f, m1[st.edge_e], m1[st.edge_f])
+    b1, b2, c = model.stencil_stiffness
+    n1, n2, nt = model.integrated_natural()
+    vor = model.voronoi_length
+    length = np.linalg.norm(x[model.network.edges[:, 1]] - x[model.network.edges[:, 0]], axis=1)
+    rest = np.asarray(model.rest_length)
+    ea = np.asarray(model.axial_stiffness)
+    return {
+        "bend_out": float(np.sum(0.5 * b1 * (k1 - n1) ** 2 / vor)),
+        "bend_in": float(np.sum(0.5 * b2 * (k2 - n2) ** 2 / vor)),
+        "twist": float(np.sum(0.5 * c * (tw - nt) ** 2 / vor)),
+        "stretch": float(np.sum(0.5 * ea * (length / rest - 1.0) ** 2 * rest)),
+    }
+
+
+def roll(lattice, state, normal) -> dict[str, float]:  # type: ignore[no-untyped-def]
+    """Median angle (degrees) between the material director and ``normal`` per edge mode."""
+    m1, _ = state.material_directors()
+    per = lattice.ghost_nodes + 1
+    mode = np.repeat(np.asarray(lattice.edge_mode), per)
+    angle = np.degrees(np.arccos(np.clip(np.abs(m1 @ normal), 0.0, 1.0)))
+    return {m: round(float(np.median(angle[mode == m])), 1) for m in ("expanding", "contracting")}
+
+
+def main(ghosts: int = 20, figure: str | None = None) -> None:
+    fm, _ = calibrated_model()
+    act = ProgramActuation(filament_model=fm)
+    rows: dict[str, list[dict]] = {}
+    for pattern in ("dome", "saddle"):
+        lattice, res, why = _heat(
+            pattern, False, LATTICE_STEPS, fm, ghosts, True,
+            lift_off_tolerance=LIFT_OFF_TOLERANCE, path_check=PATH_CHECK_FACTOR,
+        )  # fmt: skip
+        if res is None:
+            raise SystemExit(f"{pattern}: {why}")
+        rows[pattern] = []
+        for k, state in enumerate(res.states):
+            q = surface_quality(res.positions[k], lattice.branch_indices, lattice.edge_chains)
+            model = act.natural(res.model, float(res.parameter[k]))
+            row = {
+                "pattern": pattern,
+                "ghost_nodes": ghosts,
+                "temperature_C": round(float(res.parameter[k]), 2),
+                "residual_over_rise": round(q.relative_residual, 4) if k else 0.0,
+                "rise_mm": round(q.rise, 3),
+                "crossing_edges": len(q.crossing_edges),
+                "is_surface": bool(q.is_surface) if k else True,
+                "gaussian_sign": int(res.gaussian_sign[k]),
+                "stack_overlaps": int(res.stack_overlaps[k]),
+                **{key: round(v, 6) for key, v in energies(model, state).items()},
+                "roll_deg": roll(lattice, state, q.fit.frame[2]),
+            }
+            rows[pattern].append(row)
+            print(json.dumps(row), flush=True)
+    if figure:
+        _figure(rows, figure)
+
+
+def _figure(rows: dict[str, list[dict]], path: str) -> None:
+    from pathlib import Path
+
+    from rotomorph.plot.figure import new_figure, save_figure
+
+    fig = new_figure(11.0, 3.8)
+    axes = fig.subplots(1, 3)
+    colours = {"dome": "tab:red", "saddle": "tab:blue"}
+    for pattern, data in rows.items():
+        t = [r["temperature_C"] for r in data]
+        c = colours[pattern]
+        axes[0].plot(t, [100 * r["residual_over_rise"] for r in data], "o-", color=c,
+                     label=pattern)  # fmt: skip
+        for r in data:
+            if r["crossing_edges"]:
+                axes[0].plot(r["temperature_C"], 100 * r["residual_over_rise"], "x", color="k",
+                             ms=8)  # fmt: skip
+        axes[1].plot(t, [r["roll_deg"]["contracting"] for r in data], "o-", color=c,
+                     label=f"{pattern}: contracting edges")  # fmt: skip
+        axes[1].plot(t, [r["roll_deg"]["expanding"] for r in data], "s--", color=c, mfc="none",
+                     label=f"{pattern}: expanding edges")  # fmt: skip
+        end = data[-1]
+        kinds = ("bend_out", "bend_in", "twist", "stretch")
+        total = sum(end[k] for k in kinds)
+        x0 = 0.0 if pattern == "dome" else 0.4
+        axes[2].bar(np.arange(4) + x0, [end[k] / total for k in kinds], width=0.4, color=c,
+                    label=f"{pattern}, {end['temperature_C']:.0f} °C")  # fmt: skip
+    axes[0].axhline(10.0, color="0.5", ls=":", lw=1)
+    axes[0].set_xlabel("temperature (°C)")
+    axes[0].set_ylabel("fit residual / rise (%)")
+    axes[0].set_title("quadratic fit of the branch nodes\n(x: an edge crosses itself)", fontsize=9)
+    axes[1].set_xlabel("temperature (°C)")
+    axes[1].set_ylabel("director vs surface normal (°, median)")
+    axes[1].set_title("roll of the edges' stacks", fontsize=9)
+    axes[2].set_xticks(np.arange(4) + 0.2, ["bend out", "bend in", "twist", "stretch"])
+    axes[2].set_ylabel("share of elastic energy")
+    axes[2].set_title("energy at the end of the ramp", fontsize=9)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.subplots_adjust(wspace=0.35)
+    save_figure(fig, Path(path))
+
+
+if __name__ == "__main__":
+    args = sys.argv[1:]
+    g = int(args[args.index("--ghosts") + 1]) if "--ghosts" in args else 20
+    fig_path = args[args.index("--figure") + 1] if "--figure" in args else None
+    main(g, fig_path)
