@@ -36,8 +36,11 @@ import numpy as np
 
 from rotomorph.analysis.aperture import passing_diameters
 from rotomorph.contact import Contact, ContactPotential, Cylinder
+from rotomorph.contact.stack import Stack
+from rotomorph.contact.stacked import StackedContact
 from rotomorph.design.lattices import Lattice, sinusoidal_lattice
 from rotomorph.lattice.actuation import default_stiffness, get_actuation
+from rotomorph.lattice.admissibility import admissibility, lattice_stack
 from rotomorph.lattice.heating import RAMP_OPTIONS, heat_lattice
 from rotomorph.lattice.model import lattice_model
 from rotomorph.solve.continuation import continuation
@@ -73,8 +76,11 @@ def filter_study(n: int, ghost_nodes: int, steps: int) -> tuple[list[dict], dict
             "opening_max_mm": float(d.max()),
             "area_ratio": float(a),
             "stable": bool(s),
+            "admissible": bool(ok),  # no two layers of the printed stacks interpenetrate
         }
-        for t, d, a, s in zip(ramp.parameter, openings, ramp.area_ratio, ramp.stable, strict=True)
+        for t, d, a, s, ok in zip(
+            ramp.parameter, openings, ramp.area_ratio, ramp.stable, ramp.admissible, strict=True
+        )
     ]
     verdict: dict = {"study": "filter_spheres", "spacing_mm": FILTER_SPACING, "n": n}
     for size in SPHERE_DIAMETERS:
@@ -101,23 +107,30 @@ def rod_centres(lattice: Lattice) -> np.ndarray:
     return np.array(out)
 
 
-def rod_forces(result: StaticResult, rods: tuple[Cylinder, ...], radius: float) -> np.ndarray:
-    """In-plane force on each rod ``(R,)`` (N): the reaction of the filaments' barrier."""
+def rod_forces(
+    result: StaticResult, rods: tuple[Cylinder, ...], radius: float, stack: Stack
+) -> np.ndarray:
+    """In-plane force on each rod ``(R,)`` (N): the reaction of the barrier of the filaments'
+    printed layers (``stack``)."""
     bound = result.contact
     assert bound is not None
     out = []
     for rod in rods:
-        single = ContactPotential(
-            Contact(
-                radius=radius,
-                obstacles=(rod,),
-                self_contact=False,
-                stiffness=bound.kappa,
-                activation_distance=bound.dhat,
-            ),
-            bound.network,
+        settings = Contact(
+            radius=radius,
+            obstacles=(rod,),
+            self_contact=False,
+            stiffness=bound.kappa,
+            activation_distance=bound.dhat,
+            stack=stack,
         )
-        force = -single.forces(result.positions).sum(axis=0)  # on the rod
+        if stack.is_single:
+            single: ContactPotential | StackedContact = ContactPotential(settings, bound.network)
+            force = -single.forces(result.positions).sum(axis=0)  # on the rod
+        else:
+            up = np.tile([0.0, 0.0, 1.0], (bound.network.n_edges, 1))  # printed directors
+            single = StackedContact(settings, bound.network, up)
+            force = -single.forces(result.state).sum(axis=0)
         out.append(float(np.hypot(force[0], force[1])))
     return np.array(out)
 
@@ -139,7 +152,8 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
         Cylinder.along((x, y, 0.0), (0.0, 0.0, 1.0), ROD_DIAMETER / 2, ROD_LENGTH)
         for x, y, _ in rod_centres(lattice)
     )
-    contact = Contact(radius=lattice.radius, obstacles=rods)
+    stack = lattice_stack(lattice)  # every edge presents its printed layers to the rods
+    contact = Contact(radius=lattice.radius, obstacles=rods, stack=stack)
 
     def solve(temperature: float, state):  # type: ignore[no-untyped-def]
         return solve_static(
@@ -166,6 +180,7 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
             "opening_min_mm": float(printed.min()),
             "clearance": None,
             "stable": True,
+            "admissible": True,
         }
     )
     for phase, path in (("heating", up), ("cooling", down)):
@@ -177,10 +192,12 @@ def gripper_study(n: int, ghost_nodes: int, heat_steps: int, cool_steps: int) ->
                     "study": "gripper",
                     "temperature_C": float(step.parameter),
                     "phase": phase,
-                    "rod_forces_N": rod_forces(res, rods, lattice.radius).tolist(),
+                    "rod_forces_N": rod_forces(res, rods, lattice.radius, stack).tolist(),
                     "opening_min_mm": float(openings.min()),
-                    "clearance": res.contact.clearance(res.positions),  # type: ignore[union-attr]
+                    "clearance": res.contact.clearance(res.state),  # type: ignore[union-attr]
                     "stable": bool(res.stable),
+                    # no two layers of the printed stacks pass through each other
+                    "admissible": admissibility(lattice, res.state, contact=contact).admissible,
                 }
             )
     return rows

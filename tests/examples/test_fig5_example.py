@@ -22,6 +22,9 @@ def test_fig5_example(capsys):
     (geometry,) = [r for r in rows if r["study"] == "gripper_geometry"]
 
     assert all(r["stable"] for r in filt + grip)
+    # the printed stacks' layers never pass through each other (the gripper's rest on the rods
+    # layer by layer)
+    assert all(r["admissible"] for r in filt + grip)
     assert filt[0]["opening_min_mm"] < 5.0 < filt[-1]["opening_min_mm"]
     assert spheres["sphere_5mm"].startswith("caught below, passes from")
     assert spheres["sphere_3mm"].startswith("passes already")

@@ -539,7 +539,9 @@ class LatticeModel(_Process):
         "central_cells", description="which edges count as central for dome/saddle"
     )
     layers: int = _ranged("layers", 3, "printed layers")
-    layer_height: float = _ranged("layer_height", 0.6, "layer height")
+    layer_height: float = _ranged(
+        "layer_height", 0.6, "layer height, at most 2 x radius when layers > 1 (layers touch)"
+    )
     speed: Speed = 3.0
     edge_speeds: list[Speed] | None = Field(
         None, description="one print speed per lattice edge, 2n(n-1) of them (mm/s)"
@@ -573,6 +575,16 @@ class LatticeModel(_Process):
                     f"mm, below the filament radius {self.radius:g} mm: their inner side would "
                     f"overlap itself; use amplitude <= {most:.3g} mm or a larger spacing"
                 )
+        return self
+
+    @model_validator(mode="after")
+    def _layers_touch(self) -> LatticeModel:
+        if self.layers > 1 and self.layer_height > 2.0 * self.radius * (1.0 + 1e-9):
+            raise ValueError(
+                f"layers {self.layer_height:g} mm apart do not touch (filament diameter "
+                f"{2.0 * self.radius:g} mm): a printed stack needs layer_height <= "
+                f"{2.0 * self.radius:g} mm (2 x radius)"
+            )
         return self
 
     @model_validator(mode="after")

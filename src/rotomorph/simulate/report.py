@@ -107,6 +107,29 @@ def _end_physical(res: Any) -> tuple[bool, str]:
     return not why, "; ".join(why)
 
 
+def _surface(lattice: Any, res: Any) -> Any:
+    """How the end state reads as a surface (:func:`rotomorph.analysis.surface.surface_quality`)."""
+    from rotomorph.analysis.surface import surface_quality
+
+    return surface_quality(res.positions[-1], lattice.branch_indices, lattice.edge_chains)
+
+
+def _surface_record(lattice: Any, res: Any) -> dict[str, Any]:
+    q = _surface(lattice, res)
+    return {
+        "residual_over_rise": round(q.relative_residual, 4),
+        "rise_mm": round(q.rise, 3),
+        "crossing_edges": len(q.crossing_edges),
+        "is_surface": bool(q.is_surface),
+    }
+
+
+def _surface_text(lattice: Any, res: Any) -> str:
+    q = _surface(lattice, res)
+    verdict = "yes" if q.is_surface else "no"
+    return f"{verdict} ({q.text()}; docs/validation.md, *Lattices as printed*)"
+
+
 def _flagged(title: str, res: Any) -> tuple[str, str]:
     """A figure title with NOT PHYSICAL (and its reason) added where the end state is not
     physical, and the title's colour."""
@@ -699,6 +722,7 @@ def _lattice_section(
                 figure="fig4cf_characteristic_curvature.png",
                 physical=_end_physical(res)[0],
                 physical_reason=_end_physical(res)[1],
+                surface=None if res is None else _surface_record(lattice, res),
                 note=why
                 or f"{size}; sign of the fitted Gaussian curvature of the branch nodes at the "
                 f"end of the ramp ({res.parameter[-1]:.4g}), "
@@ -709,7 +733,8 @@ def _lattice_section(
                     if res.contact is not None
                     else "quick mode: no contact (min clearance "
                     f"{np.min(res.min_clearance):.2f} diameters)"
-                ),
+                )
+                + f"; read as a surface: {_surface_text(lattice, res)}",
             )
         )
         rows.append(

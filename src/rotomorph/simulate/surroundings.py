@@ -94,10 +94,14 @@ def lattice_surroundings(
     temperature (:func:`rotomorph.lattice.heating.lattice_buoyancy`)."""
     if contact is None:
         return {}
+    from rotomorph.lattice.admissibility import lattice_stack  # lattice-only
     from rotomorph.lattice.heating import lattice_buoyancy  # lattice-only
 
     kwargs: dict[str, Any] = {
-        "contact": Contact(radius=lattice.radius, self_contact=contact.self_contact),
+        # the printed stack's layers touch, one capsule each (docs/contact.md)
+        "contact": Contact(
+            radius=lattice.radius, self_contact=contact.self_contact, stack=lattice_stack(lattice)
+        ),
         "floor": bool(contact.floor),
         "friction": float(contact.friction),
         "branch": str(contact.branch),
