@@ -780,7 +780,9 @@ class ContactPotential:
 
     # ------------------------------------------------------------------ measures
     def forces(self, x: FloatArray) -> FloatArray:
-        """Contact force on every node ``(N, 3)`` (N): minus the barrier gradient."""
+        """Contact force on every node ``(N, 3)`` (N): minus the barrier gradient. The
+        measures take node positions or a rod ``State`` (as a stacked contact does)."""
+        x = _positions(x)
         _, g, _ = self.evaluate(x, True, 0)
         if g is None:
             raise InfeasibleContactError("positions", "filaments touch or interpenetrate")
@@ -789,7 +791,7 @@ class ContactPotential:
     def obstacle_forces(self, x: FloatArray) -> list[FloatArray]:
         """Resultant contact force on each obstacle ``(3,)`` (N), in ``contact.obstacles`` order
         (e.g. the force a gripper's lattice exerts on each rod). Friction is not included."""
-        x = np.ascontiguousarray(x, dtype=float)
+        x = np.ascontiguousarray(_positions(x), dtype=float)
         cand = self.candidates(x)
         xe = self._extended(x)
         n = self.n_nodes
@@ -828,7 +830,7 @@ class ContactPotential:
 
     def _distances(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """:meth:`distances` with the distances at which the barrier is infinite."""
-        x = np.ascontiguousarray(x, dtype=float)
+        x = np.ascontiguousarray(_positions(x), dtype=float)
         cand = self.candidates(x, margin=self._dmin_max)
         d = pair_distances(self._extended(x), cand.quads)
         heights = [f.height_of(x[g[0]]) for f, g in zip(self._floors, cand.floors, strict=True)]
@@ -895,6 +897,11 @@ def _plane_bases(normals: FloatArray) -> FloatArray:
     a[flat] = np.cross(n[flat], [0.0, 1.0, 0.0])
     a /= np.linalg.norm(a, axis=1, keepdims=True)
     return np.stack([a, np.cross(n, a)], axis=2)
+
+
+def _positions(x: FloatArray) -> FloatArray:
+    """Node positions of ``x``: positions themselves, or a rod ``State``'s."""
+    return np.asarray(getattr(x, "positions", x), dtype=float)
 
 
 def _largest_norm(v: FloatArray) -> float:

@@ -9,6 +9,7 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.contact.potential import Contact, ContactPotential
+from rotomorph.contact.stacked import StackedContact
 from rotomorph.errors import ConvergenceError
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
@@ -42,8 +43,10 @@ class StaticResult:
         Seconds spent in the solve.
     contact
         The contact model bound to the network when the solve had contact (None otherwise):
-        ``result.contact.forces(result.positions)``, ``.clearance(...)``,
-        ``.active_contacts(...)``.
+        ``result.contact.forces(result.state)``, ``.clearance(...)``,
+        ``.active_contacts(...)`` (node positions also do, except for a printed stack's
+        contact, :class:`~rotomorph.contact.stacked.StackedContact`, which reads its layers
+        off the state's material frames).
     stable
         True: certified a local minimum (the Hessian on the free DOFs, rigid motions removed,
         is positive definite or neutral within round-off; see
@@ -71,7 +74,7 @@ class StaticResult:
     energy: float
     residual: float
     wall_time: float
-    contact: ContactPotential | None = None
+    contact: ContactPotential | StackedContact | None = None
     stable: bool = False
     eigenvalues: FloatArray = field(default_factory=lambda: np.zeros(0))
     modes: Modes | None = None
