@@ -24,9 +24,10 @@ calibration: the package keeps the section its geometry gives.
 ``--fused H``: the same with the layers H mm apart (overlapping below one diameter: the fused
 section's own torsion, bending and contact shape).
 
-``--figure PATH`` draws the residual, the roll, the energy shares and the what-if. Run:
+``--figure PATH`` draws the residual, the roll, the energy shares and the what-if;
+``--replot LINES`` draws it from the JSON lines of an earlier run instead of running. Run:
 ``python benchmarks/lattice_surface.py [--ghosts G] [--torsion 1,3,10] [--fused H]
-[--figure PATH]``
+[--figure PATH] [--replot LINES]``
 (default 20 ghost nodes per edge, the report's counted resolution).
 """
 
@@ -168,9 +169,26 @@ def main(
             print(json.dumps(tries[-1]), flush=True)
     if fused is not None:  # overlapping layers: the fused section's own stiffnesses and contact
         for pattern in ("dome", "saddle"):
-            print(json.dumps(what_if(pattern, fm, 1.0, ghosts, fused)), flush=True)
+            tries.append(what_if(pattern, fm, 1.0, ghosts, fused))
+            print(json.dumps(tries[-1]), flush=True)
     if figure:
         _figure(rows, tries, figure)
+
+
+def replot(lines: str, path: str) -> None:
+    """Draw the figure from the JSON lines of an earlier run (file ``lines``)."""
+    from pathlib import Path
+
+    rows: dict[str, list[dict]] = {}
+    tries: list[dict] = []
+    for text in Path(lines).read_text(encoding="utf-8").splitlines():
+        if text.strip():
+            r = json.loads(text)
+            if "torsion_factor" in r:
+                tries.append(r)
+            else:
+                rows.setdefault(r["pattern"], []).append(r)
+    _figure(rows, tries, path)
 
 
 def _figure(rows: dict[str, list[dict]], tries: list[dict], path: str) -> None:
@@ -178,7 +196,7 @@ def _figure(rows: dict[str, list[dict]], tries: list[dict], path: str) -> None:
 
     from rotomorph.plot.figure import new_figure, save_figure
 
-    fig = new_figure(14.5, 3.9)
+    fig = new_figure(14.5, 5.0)
     axes = fig.subplots(1, 4)
     colours = {"dome": "tab:red", "saddle": "tab:blue"}
     for pattern, data in rows.items():
@@ -208,31 +226,46 @@ def _figure(rows: dict[str, list[dict]], tries: list[dict], path: str) -> None:
     axes[1].set_xlabel("temperature (°C)")
     axes[1].set_ylabel("director vs surface normal (°, median)")
     axes[1].set_title("roll of the edges' stacks", fontsize=9)
-    axes[2].set_xticks(np.arange(4) + 0.2, ["bend out", "bend in", "twist", "stretch"])
+    axes[2].set_xticks(np.arange(4) + 0.2, ["bend\nout", "bend\nin", "twist", "stretch"])
     axes[2].set_ylabel("share of elastic energy")
-    axes[2].set_title("energy at the end of the ramp", fontsize=9)
+    axes[2].set_title("energy at the end of the ramp\n(bending out of / in the sheet)", fontsize=9)
     for pattern in ("dome", "saddle"):
-        mine = [r for r in tries if r["pattern"] == pattern]
-        if not mine:
-            continue
-        f = [r["torsion_factor"] for r in mine]
-        res = [np.nan if r["residual_over_rise"] is None else 100 * r["residual_over_rise"]
-               for r in mine]  # fmt: skip
-        axes[3].plot(f, res, "o-", color=colours[pattern], label=f"{pattern}: fit residual")
+        mine = [r for r in tries if r["pattern"] == pattern and r["layer_height_mm"] == 0.6]
+        fused = [r for r in tries if r["pattern"] == pattern and r["layer_height_mm"] != 0.6]
+        c = colours[pattern]
+        lifted = [r for r in mine if r["residual_over_rise"] is not None]
+        axes[3].plot([r["torsion_factor"] for r in lifted],
+                     [100 * r["residual_over_rise"] for r in lifted], "o-", color=c,
+                     label=f"{pattern}")  # fmt: skip
         for r in mine:
-            if r["residual_over_rise"] is None:
-                axes[3].annotate("stays flat", (r["torsion_factor"], 1.0), fontsize=7,
-                                 color=colours[pattern], rotation=90)  # fmt: skip
+            if r["residual_over_rise"] is None:  # never leaves the floor: a plane
+                axes[3].plot(r["torsion_factor"], 0.0, "v", color=c, ms=8, mfc="none")
+        for r in fused:
+            if r["residual_over_rise"] is not None:
+                label = f"{pattern}: layers fused ({r['layer_height_mm']:g} mm)"
+                axes[3].plot(1.32, 100 * r["residual_over_rise"], "D", mfc="none", color=c,
+                             label=label)  # fmt: skip
+    flat = sorted({r["torsion_factor"] for r in tries if r["residual_over_rise"] is None})
+    for f in flat:
+        who = {
+            r["pattern"]
+            for r in tries
+            if r["torsion_factor"] == f and r["residual_over_rise"] is None
+        }
+        text = "both stay flat" if len(who) == 2 else f"{who.pop()} stays flat"
+        axes[3].annotate(text, (f, 1.5), fontsize=7, rotation=90, ha="center", va="bottom")
     if tries:
         axes[3].axhline(10.0, color="0.5", ls=":", lw=1)
         axes[3].set_xscale("log")
+        axes[3].set_xlim(0.8, 15.0)
+        axes[3].set_ylim(-1.0, None)
         axes[3].set_xlabel("torsion constant / the stack's (what-if)")
         axes[3].set_ylabel("fit residual / rise (%), 175 °C")
         axes[3].set_title("if the stack twisted stiffer", fontsize=9)
     for ax in axes:
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.subplots_adjust(wspace=0.35)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
+    fig.subplots_adjust(wspace=0.35, bottom=0.36, top=0.88)
     save_figure(fig, Path(path))
 
 
@@ -246,4 +279,9 @@ if __name__ == "__main__":
         else ()
     )
     h = float(args[args.index("--fused") + 1]) if "--fused" in args else None
-    main(g, fig_path, factors, h)
+    if "--replot" in args:
+        if fig_path is None:
+            raise SystemExit("--replot needs --figure PATH")
+        replot(args[args.index("--replot") + 1], fig_path)
+    else:
+        main(g, fig_path, factors, h)
