@@ -247,6 +247,10 @@ class PublishedSweep:
         one (N mm; NaN where none was probed), None where no probe ran.
     stable
         Per value: True where certified a stable minimum.
+    stack_overlaps
+        Per value: pairs of filament segments (one layer: the centre lines' capsules) that
+        interpenetrate (:func:`rotomorph.lattice.admissibility.admissibility`; 0: admissible);
+        None where not checked.
     positions
         Node positions per value ``(K, N, 3)`` (mm).
     negative, positive
@@ -268,6 +272,19 @@ class PublishedSweep:
     negative: HeatingResult
     positive: HeatingResult
     cpu_time: float
+    stack_overlaps: IntArray | None = None
+
+    @property
+    def physical(self) -> tuple[bool, ...]:
+        """Per value: certified stable and admissible (no filaments interpenetrating); a value
+        whose admissibility was not checked is not counted as physical."""
+        overlaps = (
+            (None,) * len(self.stretch) if self.stack_overlaps is None else self.stack_overlaps
+        )
+        return tuple(
+            s is True and c is not None and int(c) == 0
+            for s, c in zip(self.stable, overlaps, strict=True)
+        )
 
     @property
     def lattice(self) -> Lattice:
@@ -391,6 +408,7 @@ def published_sweep(
         negative=neg,
         positive=pos,
         cpu_time=cpu_neg + cpu_pos,
+        stack_overlaps=join(neg.stack_overlaps, pos.stack_overlaps),
     )
 
 

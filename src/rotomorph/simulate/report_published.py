@@ -77,6 +77,24 @@ def _sweep(step: float, end: float, weightless: bool) -> PublishedSweep:
     return disk_cached("published_sweep", key, lambda: published_sweep(step, end))
 
 
+def not_physical(sweep: PublishedSweep, k: int) -> str | None:
+    """Why value ``k`` of ``sweep`` is not physical (None: certified stable, no filaments
+    interpenetrating; :func:`rotomorph.lattice.admissibility.admissibility`)."""
+    why = []
+    if sweep.stable[k] is not True:
+        why.append("not certified stable")
+    overlaps = None if sweep.stack_overlaps is None else int(sweep.stack_overlaps[k])
+    if overlaps is None:
+        why.append("admissibility not checked")
+    elif overlaps:
+        why.append(f"{overlaps} segment pairs interpenetrate")
+    return "; ".join(why) or None
+
+
+def _bad_values(sweep: PublishedSweep) -> list[int]:
+    return [k for k in range(len(sweep.stretch)) if not_physical(sweep, k) is not None]
+
+
 def sweep_figure(on_floor: PublishedSweep, weightless: PublishedSweep | None = None) -> Any:
     """√|k1 k2| l and the rise off the floor against stretch (the report's Fig. 4 sweep)."""
     from rotomorph.plot.figure import new_figure
@@ -111,6 +129,12 @@ def sweep_figure(on_floor: PublishedSweep, weightless: PublishedSweep | None = N
                     label=f"{names[sign]}{', fit residual > 10 % of rise' if bad else ''}",
                     zorder=3,
                 )
+    unphysical = _bad_values(on_floor)
+    if unphysical:
+        curv.scatter(
+            s[unphysical], k[unphysical], s=30, marker="x", color="k", linewidths=0.8, zorder=4,
+            label="NOT PHYSICAL (unstable or filaments interpenetrating)",
+        )  # fmt: skip
     for ax in (curv, rise):
         ax.axvline(LOGGED_STRETCH, color="k", lw=0.8, ls=":")
         ax.grid(alpha=0.3)
@@ -125,7 +149,10 @@ def sweep_figure(on_floor: PublishedSweep, weightless: PublishedSweep | None = N
         ha="right",
     )
     curv.set_ylabel("√|k1 k2| · l (–)")
-    curv.set_title("rotomorph on the authors' set-up: curvature of the branch-node fit", fontsize=9)
+    title = "rotomorph on the authors' set-up: curvature of the branch-node fit"
+    if unphysical:
+        title += f"\nNOT PHYSICAL at {len(unphysical)} of {len(s)} values (x)"
+    curv.set_title(title, fontsize=9, color="tab:red" if unphysical else "k")
     curv.legend(fontsize=6.5, loc="upper right")
     if on_floor.floor_lift is not None:
         rise.plot(s, on_floor.floor_lift / SPACING, color="k", lw=1.0)
@@ -163,11 +190,14 @@ def shapes_figure(sweep: PublishedSweep, shown: tuple[float, ...] = SHOWN) -> An
         sign = int(sweep.gaussian_sign[k])
         kind = {1: "dome", -1: "saddle", 0: "flat"}[sign]
         fit = sweep.fit_residual[k]
+        why = not_physical(sweep, k)
         ax.set_title(
             f"stretch {sweep.stretch[k]:+.2f}: {kind}\n√|k1k2|·l = "
             f"{sweep.characteristic_curvature[k] * SPACING:.2f}"
-            f"{' (poor fit)' if fit > POOR_FIT else ''}",
+            f"{' (poor fit)' if fit > POOR_FIT else ''}"
+            f"{'' if why is None else chr(10) + 'NOT PHYSICAL: ' + why}",
             fontsize=8,
+            color="k" if why is None else "tab:red",
         )
     fig.suptitle(
         "The authors' lattice (l = 1 m cells, r = 1 mm) in rotomorph: static equilibria on the "
@@ -193,6 +223,11 @@ def records(sweep: PublishedSweep, case: str) -> list[dict[str, Any]]:
                 "fit_residual_over_rise": float(sweep.fit_residual[k]),
                 "floor_lift_mm": None if sweep.floor_lift is None else float(sweep.floor_lift[k]),
                 "stable": sweep.stable[k],
+                "stack_overlaps": (
+                    None if sweep.stack_overlaps is None else int(sweep.stack_overlaps[k])
+                ),
+                "physical": not_physical(sweep, k) is None,
+                "physical_reason": not_physical(sweep, k),
                 "wall_s": float(sweep.wall_time[k]),
             }
         )
@@ -245,6 +280,30 @@ def _logged(floor: PublishedSweep, free: PublishedSweep) -> str:
     else:
         text += "."
     return text
+
+
+def _admissibility_lines(floor: PublishedSweep, free: PublishedSweep) -> list[str]:
+    """The section's statement on physical states: how many values of each sweep are
+    certified stable with no filaments interpenetrating, and which are NOT PHYSICAL."""
+    out = []
+    for name, sweep in (("on the floor", floor), ("weightless", free)):
+        bad = _bad_values(sweep)
+        if not bad:
+            out.append(
+                f"- **Physical states ({name})**: all {len(sweep.stretch)} values certified "
+                "stable, with no two filament segments interpenetrating "
+                "(`rotomorph.lattice.admissibility`)."
+            )
+            continue
+        listed = ", ".join(
+            f"{sweep.stretch[k]:+.2f} ({not_physical(sweep, k)})" for k in bad[:8]
+        ) + (" …" if len(bad) > 8 else "")
+        out.append(
+            f"- **NOT PHYSICAL ({name})**: {len(bad)} of {len(sweep.stretch)} values are not "
+            f"certified stable or have filaments interpenetrating: {listed}. Their rows in "
+            "`published_fig4_sweep.json` say `physical: false`; the figure marks them (x)."
+        )
+    return [*out, ""]
 
 
 def published_section(folder: Path, figs: Path | None, *, quick: bool) -> PublishedSection:
@@ -331,6 +390,7 @@ def published_section(folder: Path, figs: Path | None, *, quick: bool) -> Publis
         f"per value (~{runs * cpu_lo:.0f}–{runs * cpu_hi:.0f} CPU-hours for the sweep).",
         "",
     ]
+    lines += _admissibility_lines(floor, free)
     for p in paths:
         lines += [f"![{p.stem}](figures/{p.name})", ""]
     return PublishedSection(lines=lines, figures=paths, on_floor=floor, weightless=free)
