@@ -6,11 +6,12 @@ the logged run's E = 2e11 Pa, floor friction 0.4 and weight) swept over the 151 
 -0.75 ... +0.75 by 0.01 by continuation: 0 -> -0.75 and 0 -> +0.75, every value starting from
 the equilibrium of its neighbour nearer zero; the two ramps run side by side in a two-worker
 process pool (``--workers 1``: one after the other). One line per value (``stretch``, ``wall_s``,
-``characteristic_curvature`` in 1/mm, ``gaussian_sign``, and the node rise above the floor
-``floor_lift_mm``) and a total line (``case = "total"``: ``values``, ``wall_s`` and ``cpu_s`` of
-the whole sweep (CPU of both ramps, wherever they ran), ``workers``, the authors' logged run for
-one value, ``authors_run_s`` = 706.4 s, and the ratio). Kernels are compiled before the clock
-starts.
+``characteristic_curvature`` in 1/mm, ``gaussian_sign``, the node rise above the floor
+``floor_lift_mm``, ``stack_overlaps`` (filament segment pairs interpenetrating) and
+``physical`` (certified stable and admissible)) and a total line (``case = "total"``:
+``values``, ``wall_s`` and ``cpu_s`` of the whole sweep (CPU of both ramps, wherever they
+ran), ``workers``, the authors' logged run for one value, ``authors_run_s`` = 706.4 s, and the
+ratio). Kernels are compiled before the clock starts.
 
 Run: ``python benchmarks/paper_sweep.py [--quick] [--workers N]`` (``--quick``: |stretch| <= 0.25
 by 0.05, 11 values).
@@ -66,6 +67,10 @@ def main(quick: bool = False, workers: int = 2) -> None:
                     "floor_lift_mm": None
                     if sweep.floor_lift is None
                     else round(float(sweep.floor_lift[k]), 3),
+                    "stack_overlaps": None
+                    if sweep.stack_overlaps is None
+                    else int(sweep.stack_overlaps[k]),
+                    "physical": sweep.physical[k],
                 }
             )
         )

@@ -22,7 +22,9 @@ much their small weight delays the lift-off.
 
 Prints one JSON object per stretch value and sweep (``case``, ``stretch``,
 ``characteristic_curvature`` (1/mm) and ``characteristic_curvature_times_l``,
-``gaussian_sign``, ``fit_residual_over_rise``, ``floor_lift_mm``, ``wall_s``) and a
+``gaussian_sign``, ``fit_residual_over_rise``, ``floor_lift_mm``, ``stable``,
+``stack_overlaps``, ``physical`` and ``physical_reason`` (NOT PHYSICAL: not certified stable
+or filaments interpenetrating), ``wall_s``) and a
 ``case = "total"`` line with the CPU time of each sweep next to the authors' 11 min 46 s per
 value; writes ``OUT/published_fig4_sweep.png`` (√|k1 k2| and sign against stretch) and
 ``OUT/published_fig4_shapes.png`` (domes and saddles).
