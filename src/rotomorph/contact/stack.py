@@ -15,7 +15,7 @@ Which layer pairs may touch (:func:`stack_exclusion`): layers of one segment and
 joined by a short path along the network are one piece of material. A rod of radius r bends
 back onto itself only after half a turn at the tightest radius its thickness allows; a layer at
 offset o of a stack that bends toward its director runs at radius ρ − o when the centre line
-runs at ρ, so the layer reaches its own tightest radius r at ρ = r + |o|. Layer pair (k, l) of
+runs at ρ, so the layer reaches its own tightest radius r at ρ = r + ‖o‖. Layer pair (k, l) of
 two segments is therefore excluded when their graph distance (shortest path along the printed
 network between their nearest nodes) is below
 

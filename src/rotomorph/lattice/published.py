@@ -296,7 +296,7 @@ class PublishedSweep:
         return int(np.argmin(np.abs(self.stretch - float(stretch))))
 
     def first(self, sign: int) -> float | None:
-        """Smallest |stretch| at which the Gaussian sign is ``sign`` (signed), or None."""
+        """Smallest stretch magnitude at which the Gaussian sign is ``sign`` (signed), or None."""
         hit = [s for s, g in zip(self.stretch, self.gaussian_sign, strict=True) if g == sign]
         return None if not hit else float(min(hit, key=abs))
 
