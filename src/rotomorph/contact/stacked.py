@@ -52,6 +52,7 @@ from numba import njit
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.contact.broadphase import stack_exclusion_masks, stack_near_pairs
+from rotomorph.contact.friction import FrictionLag
 from rotomorph.contact.potential import (
     DEFAULT_ACTIVATION,
     Contact,
@@ -265,8 +266,21 @@ class StackedContact:
 
     # ------------------------------------------------------------------ friction
     def set_lag(self, x0: StateLike) -> None:
-        """Lag friction at configuration ``x0`` (a State or ``(positions, m1)``)."""
+        """Lag friction at configuration ``x0`` (a State or ``(positions, m1)``), or take the
+        settings' own ``friction_lag`` (one of :meth:`lag`)."""
         self.layers.set_lag(self.points(*_state(x0)))
+
+    @property
+    def friction_lag(self) -> FrictionLag | None:
+        """The lagged friction of the current solve, on the layer network (None without)."""
+        return self.layers.friction_lag
+
+    def lag(self, x0: StateLike, at: StateLike | None = None) -> FrictionLag:
+        """:meth:`ContactPotential.lag` of the layer points: the contacts carrying force at
+        configuration ``at`` (default ``x0``; States or ``(positions, m1)``), slips measured
+        from ``x0``."""
+        end = None if at is None else self.points(*_state(at))
+        return self.layers.lag(self.points(*_state(x0)), at=end)
 
     # ------------------------------------------------------------------ measures
     def forces(self, x: StateLike) -> FloatArray:

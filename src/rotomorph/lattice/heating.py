@@ -36,6 +36,7 @@ from rotomorph.analysis.area import lattice_boundary_loop, normalized_area
 from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.analysis.shape import edge_end_to_end_ratios, end_to_end_ratio
 from rotomorph.contact import Contact, Floor, InfeasibleContactError
+from rotomorph.contact.stacked import StackedContact
 from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidParameterError
 from rotomorph.geometry import parallel_transport, unit
@@ -1179,7 +1180,11 @@ def relag_friction(
         pot = res.contact
         assert pot is not None  # solved with contact settings
         used = pot.friction_lag
-        new = pot.lag(start.positions, at=res.positions)
+        new = (
+            pot.lag(start, at=res.state)  # the layer points of the printed stack
+            if isinstance(pot, StackedContact)
+            else pot.lag(start.positions, at=res.positions)
+        )
         change = 0.0 if used is None else lag_change(used, new)
         logger.debug("friction lag %d: change %.3g", k, change)
         if change <= FRICTION_LAG_TOL:
