@@ -311,9 +311,10 @@ def stack_overlaps(
     radius: FloatArray,
     stack: Stack,
     excluded: IntArray,
+    tolerance: float = 0.0,
 ) -> StackOverlaps:
     """Every pair of layers of two segments allowed to touch whose centre lines are closer than
-    ``r_a + r_b`` (they interpenetrate), in configuration ``positions``.
+    ``r_a + r_b - tolerance`` (they interpenetrate), in configuration ``positions``.
 
     Parameters
     ----------
@@ -329,6 +330,10 @@ def stack_overlaps(
         The layer offsets.
     excluded
         Sorted virtual keys of :func:`stack_exclusion` (pairs that never touch).
+    tolerance
+        Depth (mm) a pressed contact may reach inside ``r_a + r_b``: the contact model's
+        compliant zone (``Contact.offset``; its barrier is infinite that far inside); 0: any
+        overlap counts.
     """
     edges = np.asarray(edges, dtype=np.int64)
     radius = np.asarray(radius, dtype=float)
@@ -360,7 +365,7 @@ def stack_overlaps(
     quads = np.ascontiguousarray(np.concatenate([vedges[cand[:, 0]], vedges[cand[:, 1]]], 1))
     d = pair_distances(np.ascontiguousarray(pts, dtype=float), quads)
     dmin = vrad[cand[:, 0]] + vrad[cand[:, 1]]
-    bad = d < dmin
+    bad = d < dmin - float(tolerance)
     cand = cand[bad]
     seg, lay = cand % ne, cand // ne
     swap = seg[:, 0] > seg[:, 1]  # lower segment first

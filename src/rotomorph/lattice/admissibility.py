@@ -8,6 +8,9 @@ the network, and the layers of one segment, are one piece of material: the conta
 exclusion). :func:`admissibility` rebuilds every layer's centre line from a state's positions
 and material frames and lists the layer pairs that interpenetrate; a state with any is not
 physical, whatever the solver's convergence and stability say, and every output flags it.
+A pressed contact may settle inside touching by less than the contact's offset (its compliant
+zone, ``Contact.offset``: the barrier is infinite that far inside, so a state solved with the
+stack in contact never goes deeper); only deeper overlaps count.
 
 Every counted state, every figure's state and every candidate of the lift probe and the path
 check goes through this one function (:mod:`rotomorph.lattice.heating`,
@@ -77,13 +80,17 @@ class Admissibility:
         )
 
 
-def _settings(lattice: Lattice, contact: Contact | None) -> tuple[float, float | None]:
-    """Activation distance (mm) and reach (mm or None) of the exclusion: the contact's own."""
+def _settings(lattice: Lattice, contact: Contact | None) -> tuple[float, float | None, float]:
+    """Activation distance (mm) and reach (mm or None) of the exclusion, the contact's own, and
+    its offset (mm): how far inside touching a pressed contact may settle (the barrier is
+    infinite there; ``Contact.offset``, default the activation distance)."""
     if contact is None:
-        return DEFAULT_ACTIVATION * 2.0 * float(lattice.radius), None
+        dhat = DEFAULT_ACTIVATION * 2.0 * float(lattice.radius)
+        return dhat, None, dhat
     r = contact.radii(lattice.network.n_edges)
-    dhat = contact.activation_distance or DEFAULT_ACTIVATION * 2.0 * float(r.min())
-    return float(dhat), contact.reach
+    dhat = float(contact.activation_distance or DEFAULT_ACTIVATION * 2.0 * float(r.min()))
+    offset = getattr(contact, "offset", None)
+    return dhat, contact.reach, dhat if offset is None else float(offset)
 
 
 def _excluded(lattice: Lattice, stack: Stack, dhat: float, reach: float | None) -> IntArray:
@@ -140,11 +147,12 @@ def admissibility(
             f"lattice; got {positions.shape} and {directors.shape}",
         )
     stack = lattice_stack(lattice)
-    dhat, reach = _settings(lattice, contact)
+    dhat, reach, offset = _settings(lattice, contact)
     radius = np.full(net.n_edges, float(lattice.radius))
     found = stack_overlaps(
-        positions, net.edges, directors, radius, stack, _excluded(lattice, stack, dhat, reach)
-    )
+        positions, net.edges, directors, radius, stack, _excluded(lattice, stack, dhat, reach),
+        tolerance=offset,
+    )  # fmt: skip
     return Admissibility(found, stack.count)
 
 
