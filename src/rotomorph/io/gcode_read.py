@@ -81,7 +81,7 @@ class GcodeReport:
     feed_range
         Lowest and highest print feed (mm/s).
     max_start_turns
-        Largest |rotary word| at a filament start, in turns.
+        Largest magnitude of the rotary word at a filament start, in turns.
     time
         Estimated run time (s): feed moves at their F, rapids at ``travel_feed``, dwells.
     """
