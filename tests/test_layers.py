@@ -1,5 +1,5 @@
 """Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis ->
-lattice -> io -> plot -> simulate -> inverse | sweep | prediction -> cli; errors, type aliases
+lattice -> io -> plot -> simulate -> inverse | sweep | prediction -> app -> cli; errors, type aliases
 and geometry sit below all."""
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ LAYERS = [
     {"plot"},
     {"simulate"},
     {"inverse", "sweep", "prediction"},
+    {"app"},
     {"cli", "__main__"},
 ]
 RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}

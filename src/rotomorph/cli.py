@@ -14,6 +14,7 @@ Commands::
     rotomorph predict DESIGN.toml [--json]    closed-form shapes with the calibration band
     rotomorph predict --for curvature=0.4     print settings that give a wanted shape
     rotomorph calibrate TABLES.csv… -o INKS.toml   a lab's own inks from its measurements
+    rotomorph serve [--port N] [--no-open]    the designer in the browser (needs [app])
 
 Exit codes: 0 success; 1 the computation failed (solver did not converge);
 2 bad input (command line, design file, machine limits, missing file, existing output folder).
@@ -868,6 +869,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--force", action="store_true", help="replace an existing materials file")
     p.set_defaults(func=_cmd_calibrate)
+    from rotomorph.app import command as serve
+
+    p = sub.add_parser("serve", help="the designer in the browser", description=serve.__doc__)
+    serve.add_arguments(p)
+    p.set_defaults(func=serve.command)
     return parser
 
 

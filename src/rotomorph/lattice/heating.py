@@ -62,7 +62,7 @@ from rotomorph.lattice.resting import resting_rotation
 from rotomorph.rod.assembly import reference_twist
 from rotomorph.rod.model import Model
 from rotomorph.rod.state import State
-from rotomorph.solve.continuation import ContinuationResult, continuation
+from rotomorph.solve.continuation import ContinuationResult, ContinuationStep, continuation
 from rotomorph.solve.loads import Gravity, Loads, Supports
 from rotomorph.solve.newton import NewtonOptions
 from rotomorph.solve.objective import RodObjective
@@ -457,6 +457,7 @@ def heat_lattice(
     path_check: int = 1,
     youngs_modulus: float | None = None,
     progress: Callable[[int], None] | None = None,
+    on_step: Callable[[int, float, State, StaticResult | None], None] | None = None,
 ) -> HeatingResult:
     """Ramp ``actuation`` over ``steps`` equal steps from the flat printed lattice.
 
@@ -544,6 +545,11 @@ def heat_lattice(
         sub-stepped ramp: ``steps * (1 + path_check)`` calls with a path check, ``steps``
         without (halvings and the lift-off bisection are not counted). Each solve is also
         announced on the ``rotomorph.progress`` logger ("ramp step 3 of 8 at 131.2 °C").
+    on_step
+        ``on_step(k, parameter, state, result)`` as each step of the first ramp is reached,
+        the printed state first (``k = 0``, row 0 of the result; ``result`` None): to show converged states
+        while the ramp runs. With ``path_check > 1`` the kept end state may come from the
+        second ramp, which is not reported step by step.
 
     Returns
     -------
@@ -658,7 +664,17 @@ def heat_lattice(
         return res
 
     phase_log.info("set-up: Hessian sparsity pattern and ordering with the first solve")
-    path = continuation(solve, values[1:], initial, start=values[0], max_halvings=max_halvings)
+
+    def reached(step: ContinuationStep) -> None:
+        if on_step is not None:
+            k = int(np.argmin(np.abs(values - step.parameter)))
+            on_step(k, float(step.parameter), step.result.state, step.result)
+
+    if on_step is not None:
+        on_step(0, float(values[0]), lm.model.reference_state(), None)
+    path = continuation(
+        solve, values[1:], initial, start=values[0], max_halvings=max_halvings, on_step=reached
+    )
     finals = path.results
     checked: PathCheck | None = None
     if factor > 1:

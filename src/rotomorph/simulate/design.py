@@ -42,7 +42,13 @@ from rotomorph.simulate.surroundings import (
     surroundings_record,
 )
 
-__all__ = ["DesignSimulation", "filaments_simulation", "simulate_design", "step_count"]
+__all__ = [
+    "DesignSimulation",
+    "StepReport",
+    "filaments_simulation",
+    "simulate_design",
+    "step_count",
+]
 
 Progress = Callable[[int], None]
 #: Phase messages (set-up, solve, analysis); the CLI shows them on a terminal.
@@ -111,6 +117,81 @@ class DesignSimulation:
             units={"positions": "mm", **self.units},
             metadata=to_jsonable(dict(self.metadata)),
         )
+
+
+@dataclass(frozen=True, eq=False)
+class StepReport:
+    """One converged step of a running :func:`simulate_design` (``on_step``), before the run ends.
+
+    Attributes
+    ----------
+    unit, units
+        Which filament (0-based) of how many is being heated (a lattice: 0 of 1).
+    step, steps
+        Step index ``k`` of ``steps + 1`` states (0: the printed state).
+    value, ramp
+        The ramp's value at this step and its name: ``"temperature"`` (°C) or ``"actuation"``.
+    positions
+        Node positions ``(N_unit, 3)`` (mm, lab frame: a lattice's origin added) of this
+        filament or of the lattice.
+    state
+        The rod state (material directors give the Janus sides).
+    stable
+        True where the solver certified a stable minimum, None where it did not check.
+    residual, max_axial_strain
+        The step's relative residual and largest centre-line strain (0 at the printed step).
+    """
+
+    unit: int
+    units: int
+    step: int
+    steps: int
+    value: float
+    ramp: str
+    positions: FloatArray
+    state: Any
+    stable: bool | None
+    residual: float
+    max_axial_strain: float
+
+
+StepCallback = Callable[[StepReport], None]
+
+
+def _reporter(
+    on_step: StepCallback | None,
+    unit: int,
+    units: int,
+    steps: int,
+    ramp: str,
+    origin: Any = (0.0, 0.0, 0.0),
+) -> Any:
+    """The lower layers' ``on_step(k, value, state, result)`` as :class:`StepReport` calls."""
+    if on_step is None:
+        return None
+    shift = np.asarray(origin, dtype=float)
+    callback = on_step
+
+    def report(k: int, value: float, state: Any, result: Any) -> None:
+        callback(
+            StepReport(
+                unit=unit,
+                units=units,
+                step=int(k),
+                steps=int(steps),
+                value=float(value),
+                ramp=ramp,
+                positions=np.asarray(state.positions, dtype=float) + shift,
+                state=state,
+                stable=True if result is None or getattr(result, "stable", None) is True else None,
+                residual=0.0 if result is None else float(result.residual),
+                max_axial_strain=0.0
+                if result is None
+                else float(getattr(result, "max_axial_strain", np.nan)),
+            )
+        )
+
+    return report
 
 
 def step_count(design: Any, steps: int) -> int:
@@ -206,6 +287,7 @@ def _simulate_filaments(
     temperature: float,
     model: FilamentModel | str | None,
     progress: Progress | None,
+    on_step: StepCallback | None = None,
 ) -> DesignSimulation:
     sims = []
     for i, fil in enumerate(design.filaments):
@@ -232,6 +314,7 @@ def _simulate_filaments(
                 progress=progress,
                 contact=contact,
                 loads=loads,
+                on_step=_reporter(on_step, i, len(design.filaments), steps, "temperature"),
             )
         )
     sim = filaments_simulation(
@@ -372,6 +455,7 @@ def _simulate_lattice(
     start_temperature: float | None = None,
     temperature: float | None = None,
     model: FilamentModel | str | None = None,
+    on_step: StepCallback | None = None,
 ) -> DesignSimulation:
     from rotomorph.lattice.heating import heat_lattice  # lattice-only
 
@@ -393,10 +477,12 @@ def _simulate_lattice(
     rule = _lattice_actuation(actuation, start_temperature, temperature, model)
     hot = float(getattr(rule, "end", ACTUATION_TEMPERATURE))  # x-readings: the paper's 175 °C
     in_temperature = actuation in ("thermal", "program")  # else the ramp is an abstract x
+    ramp = "temperature" if in_temperature else "actuation"
     res = heat_lattice(
         lattice,
         actuation=rule,
         steps=steps,
+        on_step=_reporter(on_step, 0, 1, steps, ramp, design.lattice.origin),
         **lattice_surroundings(
             design.contact,
             lattice,
@@ -409,7 +495,6 @@ def _simulate_lattice(
     phase_log.info("analysis: curvature changes, areas")
     pos = np.asarray(res.positions, dtype=float) + np.asarray(design.lattice.origin, dtype=float)
     rel = np.stack([network_relative_curvature_change(p, pos[0], lattice.edge_chains) for p in pos])
-    ramp = "temperature" if in_temperature else "actuation"
     scalars = {
         ramp: np.asarray(res.parameter, dtype=float),
         "energy": np.asarray(res.energy, dtype=float),
@@ -469,6 +554,7 @@ def simulate_design(
     spacing: float | None = None,
     actuation: str | None = None,
     progress: Progress | None = None,
+    on_step: StepCallback | None = None,
 ) -> DesignSimulation:
     """Predicted shapes of a design (:class:`rotomorph.io.designfile.Design`) over heating.
 
@@ -497,6 +583,11 @@ def simulate_design(
         filaments.
     progress
         Called with the number of finished units (see :func:`step_count`).
+    on_step
+        Called with a :class:`StepReport` as each step of each filament (or of the lattice) is
+        reached, the printed state first: to show converged states while the run goes on
+        (the app streams them). A lattice with ``contact.path_check > 1`` reports its first
+        ramp; the run's result may keep the sub-stepped ramp's end state instead.
 
     Raises
     ------
@@ -531,6 +622,7 @@ def simulate_design(
             start_temperature=start_temperature,
             temperature=temperature,
             model=model,
+            on_step=on_step,
         )
     else:
         if spacing is not None:
@@ -542,6 +634,7 @@ def simulate_design(
             temperature=ACTUATION_TEMPERATURE if temperature is None else temperature,
             model=model,
             progress=progress,
+            on_step=on_step,
         )
     meta = dict(sim.metadata)
     meta.update(

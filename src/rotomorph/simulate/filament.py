@@ -65,6 +65,9 @@ PRINT_TEMPERATURE = 25.0
 ACTUATION_TEMPERATURE = 175.0
 
 Progress = Callable[[int], None]
+#: ``on_step(k, temperature, state, result)``: step ``k`` of the ramp reached at ``temperature``
+#: (°C) in ``state``; ``result`` is the step's :class:`StaticResult` (None for the printed k = 0).
+StepCallback = Callable[[int, float, State, "StaticResult | None"], None]
 
 
 @compact_display("final_ratio")
@@ -272,6 +275,7 @@ def simulate_filament(
     progress: Progress | None = None,
     contact: Contact | None = None,
     loads: Loads | Callable[[float], Loads] | None = None,
+    on_step: StepCallback | None = None,
 ) -> FilamentSimulation:
     """Equilibrium shapes of a free filament heated from ``start_temperature`` to ``temperature``.
 
@@ -300,6 +304,9 @@ def simulate_filament(
         Dead loads (:class:`rotomorph.solve.loads.Loads`), e.g. the buoyant weight of a
         filament resting on a floor obstacle; or a function of the temperature (°C) returning
         them, for loads that change along the ramp (the bath's density falls as it heats).
+    on_step
+        Called as each step is reached, the printed state first (:data:`StepCallback`): to
+        show converged states while the ramp runs.
 
     Raises
     ------
@@ -328,6 +335,8 @@ def simulate_filament(
     positions[0] = printed
     if progress is not None:
         progress(1)
+    if on_step is not None:
+        on_step(0, float(temps[0]), state, None)
     iterations_at: dict[float, int] = {}
 
     def solve(w: float, initial: State) -> StaticResult:
@@ -353,7 +362,14 @@ def simulate_filament(
             progress(1)
         return res
 
-    path = continuation(solve, np.arange(1.0, s), state, start=0.0, max_halvings=max_refinements)
+    def reached(step: Any) -> None:
+        if on_step is not None:
+            k = round(step.parameter)
+            on_step(k, float(temps[k]), step.result.state, step.result)
+
+    path = continuation(
+        solve, np.arange(1.0, s), state, start=0.0, max_halvings=max_refinements, on_step=reached
+    )
     for k, step in enumerate(path.steps, start=1):
         res = step.result
         positions[k], energy[k], residual[k] = res.positions, res.energy, res.residual

@@ -100,6 +100,7 @@ def continuation(
     max_halvings: int = 6,
     state_of: Callable[[Any], Any] = _default_state,
     retry_on: tuple[type[BaseException], ...] = (ConvergenceError,),
+    on_step: Callable[[ContinuationStep], None] | None = None,
 ) -> ContinuationResult:
     """Solve ``solve(p, state)`` for every ``p`` in ``parameters``, each from the last result.
 
@@ -120,6 +121,9 @@ def continuation(
         Extracts the next starting state from a result (default ``result.state``).
     retry_on
         Exception types that trigger a halving; anything else propagates.
+    on_step
+        Called with each :class:`ContinuationStep` as soon as its requested value is reached
+        (to show results while the path is followed); an exception it raises propagates.
 
     Returns
     -------
@@ -178,4 +182,6 @@ def continuation(
                 wall_time=time.perf_counter() - t0,
             )
         )
+        if on_step is not None:
+            on_step(steps[-1])
     return ContinuationResult(tuple(steps))

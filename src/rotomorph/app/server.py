@@ -1,0 +1,543 @@
+"""The Dash application of ``rotomorph serve``: callbacks between the page and the public API.
+
+Each callback is a thin call into rotomorph: edits are validated by :func:`rotomorph.app.editing.
+check` (``rotomorph validate``'s path), predictions come from
+:func:`rotomorph.prediction.predict_design` (``rotomorph predict``), simulations and inverse
+designs run in the session's worker (:mod:`rotomorph.app.jobs`), files are the CLI's
+(:mod:`rotomorph.app.files`). No callback waits on a computation longer than a prediction.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import uuid
+from pathlib import Path
+from typing import Any
+
+import dash
+from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
+
+from rotomorph.app import editing, files, views
+from rotomorph.app.jobs import Job, Sessions
+from rotomorph.app.layout import TARGETS, page, render_form
+from rotomorph.errors import InvalidParameterError, MachineLimitError, RotomorphError
+from rotomorph.io.tomlfile import MAX_TOML_BYTES
+
+__all__ = ["create_app"]
+
+_STYLE = Path(__file__).with_name("style.css")
+
+# The browser refuses an upload over the limit before sending it, in the CLI's words
+# (rotomorph.io.tomlfile.decode_toml_bytes); the server checks again (MAX_CONTENT_LENGTH and
+# the same parser).
+_CHECK_UPLOAD = """
+function(contents, name) {
+    if (!contents) { return [null, ""]; }
+    var comma = contents.indexOf(",");
+    var b64 = contents.length - comma - 1;
+    var pad = contents.endsWith("==") ? 2 : (contents.endsWith("=") ? 1 : 0);
+    var bytes = Math.floor(b64 * 3 / 4) - pad;
+    if (bytes > %d) {
+        return [null, name + ": is " + bytes + " bytes; the limit is %d bytes for a TOML file"];
+    }
+    return [{"name": name, "contents": contents}, ""];
+}
+""" % (MAX_TOML_BYTES, MAX_TOML_BYTES)
+
+
+def _decode(contents: str) -> bytes:
+    _, _, b64 = contents.partition(",")
+    try:
+        return base64.b64decode(b64, validate=True)
+    except binascii.Error:
+        raise InvalidParameterError("upload", "is not a file the browser sent whole") from None
+
+
+def _message(err: BaseException) -> str:
+    if isinstance(err, MachineLimitError):
+        return f"machine limits: {err}"
+    return str(err)
+
+
+def create_app(
+    *, examples: Path | None = None, sessions: Sessions | None = None
+) -> tuple[Dash, Sessions]:
+    """The Dash app and its sessions.
+
+    Parameters
+    ----------
+    examples
+        A folder with ``designs/`` and ``machines/`` of design files and machine profiles the
+        page offers (the repository's ``examples/``); None: none (uploads and built-ins only).
+    sessions
+        Session registry (caps on jobs and workers); default :class:`Sessions`.
+    """
+    sessions = sessions or Sessions()
+    designs = files.list_toml(examples / "designs" if examples else None)
+    machine_files = files.list_toml(examples / "machines" if examples else None)
+    example_choices = [(str(i), p.stem) for i, p in enumerate(designs)]
+    machine_choices = [(f"builtin:{d}", f"built-in default ({d})") for d in files.BUILTIN_MACHINES]
+    machine_choices += [(f"example:{i}", p.stem) for i, p in enumerate(machine_files)]
+
+    app = Dash(
+        __name__,
+        title="rotomorph designer",
+        update_title=None,
+        suppress_callback_exceptions=True,
+        serve_locally=True,
+    )
+    app.server.config["MAX_CONTENT_LENGTH"] = 2 * MAX_TOML_BYTES  # a refused file's base64 fits
+    app.index_string = app.index_string.replace(
+        "{%css%}", "{%css%}<style>" + _STYLE.read_text(encoding="utf-8") + "</style>"
+    )
+    app.layout = lambda: page(uuid.uuid4().hex, example_choices, machine_choices)
+
+    def design_of(data: Any) -> Any:
+        design, error = editing.check(data or {})
+        if error is not None:
+            field, line = error
+            raise InvalidParameterError(field, line.removeprefix(f"{field}: "))
+        return design
+
+    # ------------------------------------------------------------------ loading a design
+    app.clientside_callback(
+        _CHECK_UPLOAD,
+        Output("upload-checked", "data"),
+        Output("upload-error", "children"),
+        Input("upload", "contents"),
+        State("upload", "filename"),
+        prevent_initial_call=True,
+    )
+
+    @app.callback(
+        Output("design-data", "data"),
+        Output("form", "children"),
+        Output("upload-error", "children", allow_duplicate=True),
+        Input("example", "value"),
+        Input("upload-checked", "data"),
+        Input("inverse-open", "n_clicks"),
+        State("inverse-design", "data"),
+        State("sid", "data"),
+        prevent_initial_call="initial_duplicate",
+    )
+    def load(example: Any, upload: Any, _open: Any, inverse: Any, sid: str) -> Any:
+        from rotomorph.io.designfile import parse_design_bytes
+        from rotomorph.io.tomlfile import decode_toml_bytes
+
+        sessions.worker(sid)  # warm the session's worker while the person designs
+        trigger = ctx.triggered_id
+        if trigger == "upload-checked" and upload:
+            name = str(upload.get("name") or "upload")
+            try:
+                raw = _decode(str(upload["contents"]))
+                parse_design_bytes(raw, name)  # refused exactly as `rotomorph validate` would
+                data = decode_toml_bytes(raw, name)
+            except RotomorphError as err:
+                return no_update, no_update, _message(err)
+            return data, render_form(data), ""
+        if trigger == "inverse-open" and inverse:
+            return inverse, render_form(inverse), ""
+        index = example if example is not None else "0" if designs else None
+        if index is None or not str(index).isdigit() or int(index) >= len(designs):
+            data = {"schema_version": 1, "filaments": [
+                {"name": "filament", "rotation_number": 0.25,
+                 "segments": [{"kind": "line", "length": 30.0}]}]}  # fmt: skip
+            return data, render_form(data), ""
+        path = designs[int(index)]
+        data = decode_toml_bytes(path.read_bytes(), path.name)
+        return data, render_form(data), ""
+
+    # ------------------------------------------------------------------ editing
+    @app.callback(
+        Output("design-data", "data", allow_duplicate=True),
+        Input({"type": "field", "path": ALL}, "value"),
+        State({"type": "field", "path": ALL}, "id"),
+        State("design-data", "data"),
+        prevent_initial_call=True,
+    )
+    def edit(values: list[Any], ids: list[dict[str, str]], data: Any) -> Any:
+        if not data or not ids:
+            return no_update
+        new = data
+        for value, id_ in zip(values, ids, strict=True):
+            new = editing.set_field(new, id_["path"], editing.parse_value(value))
+        return new if new != data else no_update
+
+    @app.callback(
+        Output("design-data", "data", allow_duplicate=True),
+        Output("form", "children", allow_duplicate=True),
+        Input({"type": "seg-add", "fil": ALL}, "n_clicks"),
+        Input({"type": "seg-remove", "fil": ALL}, "n_clicks"),
+        State("design-data", "data"),
+        prevent_initial_call=True,
+    )
+    def segments(_add: Any, _remove: Any, data: Any) -> Any:
+        trigger = ctx.triggered_id
+        if not isinstance(trigger, dict) or not ctx.triggered[0]["value"]:
+            return no_update, no_update
+        i = int(trigger["fil"])
+        fil = data["filaments"][i]
+        segs = list(fil.get("segments", []))
+        if trigger["type"] == "seg-add":
+            segs.append({"kind": "line", "length": 10.0})
+        elif len(segs) > 1:
+            segs.pop()
+        new = editing.set_field(data, f"filaments[{i}].segments", segs)
+        return new, render_form(new)
+
+    @app.callback(
+        Output({"type": "error", "path": ALL}, "children"),
+        Output("design-error", "children"),
+        Output("prediction", "children"),
+        Output("plan", "figure"),
+        Output("plan-box", "style"),
+        Input("design-data", "data"),
+        State("selected-edge", "data"),
+    )
+    def derive(data: Any, selected: Any) -> Any:
+        from rotomorph.prediction.design import predict_design
+
+        paths = [o["id"]["path"] for o in ctx.outputs_list[0]]
+        design, error = editing.check(data or {})
+        errors = ["" for _ in paths]
+        shown = ""
+        if error is not None:
+            where = editing.error_field(error[0])
+            if where in paths:
+                errors[paths.index(where)] = error[1]
+            else:
+                shown = error[1]
+            return errors, shown, [html.Div("prediction waits for a valid design")], no_update, no_update
+        pred = predict_design(design)
+        lines = [f"'{pred.name}' at {pred.temperature:g} °C (± calibration band)", *pred.lines()]
+        prediction = [html.Div(line, className="prediction-line") for line in lines]
+        if design.lattice is None:
+            return errors, "", prediction, {}, {"display": "none"}
+        modes = editing.edge_modes(design.lattice)
+        plan = views.lattice_plan(design, modes, selected)
+        return errors, "", prediction, plan, {"display": "block"}
+
+    @app.callback(
+        Output("selected-edge", "data"),
+        Output("edge-title", "children"),
+        Output("edge-mode", "value"),
+        Output("edge-speed", "value"),
+        Input("plan", "clickData"),
+        State("design-data", "data"),
+        prevent_initial_call=True,
+    )
+    def pick_edge(click: Any, data: Any) -> Any:
+        if not click or not click.get("points"):
+            return no_update, no_update, no_update, no_update
+        point = click["points"][0]
+        if "customdata" not in point:
+            return no_update, no_update, no_update, no_update
+        edge = int(point["customdata"])
+        design = design_of(data)
+        modes = editing.edge_modes(design.lattice)
+        speeds = design.lattice.edge_speeds or [design.lattice.speed] * len(modes)
+        return edge, f"edge {edge}", modes[edge], f"{float(speeds[edge]):g}"
+
+    @app.callback(
+        Output("design-data", "data", allow_duplicate=True),
+        Output("form", "children", allow_duplicate=True),
+        Input("edge-mode", "value"),
+        Input("edge-speed", "value"),
+        State("selected-edge", "data"),
+        State("design-data", "data"),
+        prevent_initial_call=True,
+    )
+    def edit_edge(mode: Any, speed: Any, edge: Any, data: Any) -> Any:
+        if edge is None:
+            return no_update, no_update
+        design, error = editing.check(data)
+        if design is None or design.lattice is None:
+            return no_update, no_update
+        modes = editing.edge_modes(design.lattice)
+        speeds = design.lattice.edge_speeds or [design.lattice.speed] * len(modes)
+        new_mode = mode if mode != modes[edge] else None
+        new_speed = speed if speed not in (None, "") and editing.parse_value(speed) != speeds[edge] else None
+        if new_mode is None and new_speed is None:
+            return no_update, no_update
+        new = editing.set_edge(data, modes, edge, mode=new_mode, speed=new_speed)
+        return new, render_form(new)
+
+    # ------------------------------------------------------------------ jobs
+    @app.callback(
+        Output("job-status", "children"),
+        Output("poll", "disabled"),
+        Input("simulate", "n_clicks"),
+        State("design-data", "data"),
+        State("steps", "value"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def simulate(_n: Any, data: Any, steps: Any, sid: str) -> Any:
+        from rotomorph.simulate.options import check_run_options
+
+        try:
+            design = design_of(data)
+            count = editing.parse_value(steps)
+            check_run_options("lattice" if design.lattice else "filaments", steps=count)
+            sessions.submit(sid, Job("simulate", steps=int(count)),
+                            {"kind": "simulate", "design": data, "steps": int(count)})  # fmt: skip
+        except (RotomorphError, RuntimeError) as err:
+            return f"not started: {_message(err)}", no_update
+        return "starting…", False
+
+    @app.callback(
+        Output("inverse-status", "children"),
+        Output("poll", "disabled", allow_duplicate=True),
+        Input("inverse", "n_clicks"),
+        State("target-text", "value"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def inverse(_n: Any, text: Any, sid: str) -> Any:
+        from rotomorph.inverse.targets import parse_target_bytes
+        from rotomorph.io.tomlfile import decode_toml_bytes
+
+        raw = str(text or "").encode("utf-8")
+        try:
+            parse_target_bytes(raw, "target")  # refused as `rotomorph inverse` refuses a file
+            sessions.submit(sid, Job("inverse"),
+                            {"kind": "inverse", "target": decode_toml_bytes(raw, "target")})  # fmt: skip
+        except (RotomorphError, RuntimeError) as err:
+            return f"not started: {_message(err)}", no_update
+        return "designing…", False
+
+    @app.callback(
+        Output("target-text", "value"),
+        Input("target-kind", "value"),
+        prevent_initial_call=True,
+    )
+    def target_template(kind: Any) -> Any:
+        return TARGETS.get(str(kind), no_update)
+
+    @app.callback(
+        Output("job-status", "children", allow_duplicate=True),
+        Input("cancel", "n_clicks"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def cancel(_n: Any, sid: str) -> Any:
+        sessions.cancel(sid)
+        return "cancelled"
+
+    @app.callback(
+        Output("progress", "value"),
+        Output("progress", "max"),
+        Output("job-status", "children", allow_duplicate=True),
+        Output("generation", "data"),
+        Output("verdicts", "children"),
+        Output("drawn", "data"),
+        Output("poll", "disabled", allow_duplicate=True),
+        Output("inverse-status", "children", allow_duplicate=True),
+        Output("inverse-design", "data"),
+        Output("inverse-open", "disabled"),
+        Input("poll", "n_intervals"),
+        State("drawn", "data"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def poll(_n: Any, drawn: Any, sid: str) -> Any:
+        job = sessions.job(sid)
+        keep = [no_update] * 10
+        if job is None:
+            return keep[:6] + [True] + keep[7:]
+        if job.kind == "inverse":
+            done = not job.running
+            status = job.phase if job.running else job.state + (f": {job.error}" if job.error else "")
+            design = job.result["design"] if job.state == "done" and job.result else no_update
+            return (*keep[:6], done, status, design, job.state != "done")
+        steps = job.step_events()
+        total = job.steps + 1
+        value = sum(1 for e in steps if e["step"] >= 0)
+        units = steps[-1]["units"] if steps else 1
+        status = _status(job, steps, units)
+        generation, verdicts = no_update, no_update
+        if job.generation != drawn:  # something new: the view is drawn by `draw`
+            generation = job.generation
+            if job.state == "done" and job.result:
+                from rotomorph.io.results import read_results
+
+                results = read_results(Path(job.result["folder"]) / "results.h5")
+                verdicts = _verdict_rows(views.step_verdicts(results))
+            else:
+                partial = views.partial_results(job)
+                if partial is not None:
+                    verdicts = _verdict_rows(views.step_verdicts(partial))
+        maximum = total * units
+        return (str(min(value, maximum)), str(maximum), status, generation, verdicts,
+                job.generation, not job.running, *keep[7:])  # fmt: skip
+
+    @app.callback(
+        Output("run-view", "figure"),
+        Input("generation", "data"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def draw(_generation: Any, sid: str) -> Any:
+        # apart from `poll`, so that a slow drawing never holds back the progress shown
+        job = sessions.job(sid)
+        if job is None or job.kind != "simulate":
+            return no_update
+        if job.state == "done" and job.result:
+            return views.final_figure(job.result["folder"])[0]
+        figure = views.stream_figure(job)
+        return figure if figure is not None else no_update
+
+    # ------------------------------------------------------------------ files
+    @app.callback(
+        Output("design-file", "data"),
+        Output("design-error", "children", allow_duplicate=True),
+        Input("get-design", "n_clicks"),
+        State("design-data", "data"),
+        prevent_initial_call=True,
+    )
+    def get_design(_n: Any, data: Any) -> Any:
+        try:
+            design = design_of(data)
+        except RotomorphError as err:
+            return no_update, _message(err)
+        name = _file_name(design.name, "design") + ".toml"
+        return dcc.send_bytes(files.design_bytes(design), name), ""
+
+    @app.callback(
+        Output("machine", "options"),
+        Output("machine", "value"),
+        Output("machine-error", "children"),
+        Input("machine-upload", "contents"),
+        State("machine-upload", "filename"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def machine_upload(contents: Any, name: Any, sid: str) -> Any:
+        try:
+            raw = _decode(str(contents))
+            profile = files.parse_machine_bytes(raw, str(name or "profile.toml"))
+        except RotomorphError as err:
+            return no_update, no_update, _message(err)
+        sessions.files(sid)["machine"] = profile
+        options = [{"label": label, "value": v} for v, label in machine_choices]
+        options.append({"label": f"uploaded: {profile.name}", "value": "upload"})
+        return options, "upload", ""
+
+    def machine_of(choice: Any, sid: str) -> Any:
+        return files.machine_profile(str(choice), machine_files, sessions.files(sid).get("machine"))
+
+    @app.callback(
+        Output("gcode-file", "data"),
+        Output("machine-error", "children", allow_duplicate=True),
+        Input("get-gcode", "n_clicks"),
+        Input("get-config", "n_clicks"),
+        State("design-data", "data"),
+        State("machine", "value"),
+        State("cure", "value"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def get_gcode(_g: Any, _c: Any, data: Any, choice: Any, cure: Any, sid: str) -> Any:
+        try:
+            design = design_of(data)
+            program, config = files.gcode_bytes(design, machine_of(choice, sid),
+                                                cure=_cure(cure))  # fmt: skip
+        except RotomorphError as err:
+            return no_update, _message(err)
+        name = _file_name(design.name, "design")
+        if ctx.triggered_id == "get-config":
+            return dcc.send_bytes(files.controller_zip(config), f"{name}-config.zip"), ""
+        return dcc.send_bytes(program, f"{name}.gcode"), ""
+
+    @app.callback(
+        Output("toolpath", "figure"),
+        Output("machine-error", "children", allow_duplicate=True),
+        Input("preview", "n_clicks"),
+        Input("machine", "value"),
+        State("design-data", "data"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def preview(_n: Any, choice: Any, data: Any, sid: str) -> Any:
+        from rotomorph.io.gcode import plan_programs
+
+        if ctx.triggered_id == "machine" and not _n:
+            return no_update, no_update
+        try:
+            design = design_of(data)
+            machine = machine_of(choice, sid)
+            planned = plan_programs(design.to_programs(), machine)
+        except RotomorphError as err:
+            return no_update, _message(err)
+        names = [f"layer {p.layer}" for p in planned]
+        title = f"{design.name or 'design'} on {machine.name}"
+        return views.toolpath_figure(planned, names, title), ""
+
+    @app.callback(
+        Output("run-file", "data"),
+        Input("get-h5", "n_clicks"),
+        Input("get-summary", "n_clicks"),
+        Input("get-run", "n_clicks"),
+        State("sid", "data"),
+        prevent_initial_call=True,
+    )
+    def get_run(_a: Any, _b: Any, _c: Any, sid: str) -> Any:
+        job = sessions.job(sid)
+        if job is None or job.kind != "simulate" or job.state != "done" or not job.result:
+            return no_update
+        folder = Path(job.result["folder"])
+        if ctx.triggered_id == "get-h5":
+            return dcc.send_bytes((folder / "results.h5").read_bytes(), "results.h5")
+        if ctx.triggered_id == "get-summary":
+            return dcc.send_bytes((folder / "summary.json").read_bytes(), "summary.json")
+        return dcc.send_bytes(files.folder_zip(folder), "run.zip")
+
+    return app, sessions
+
+
+def _cure(text: Any) -> float:
+    import math
+
+    from rotomorph.io.design_limits import MAX_LAYER_CURE_S
+
+    value = editing.parse_value(text)
+    if value is None:
+        return 0.0
+    if not isinstance(value, int | float) or not (0 <= value <= MAX_LAYER_CURE_S and math.isfinite(value)):
+        raise InvalidParameterError(
+            "--cure", f"must be a UV dwell per layer in [0, {MAX_LAYER_CURE_S:g}] s; got {text!r}"
+        )
+    return float(value)
+
+
+def _file_name(name: str, default: str) -> str:
+    """A download's file name from a design's name: letters, digits, ``-_.`` only."""
+    safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)[:60].strip("._")
+    return safe or default
+
+
+def _status(job: Job, steps: list[dict[str, Any]], units: int) -> str:
+    if job.state == "done":
+        line = job.result.get("line", "") if job.result else ""
+        return f"done in {job.first_step_s or 0:.1f} s to the first step; {line}"
+    if job.state in ("failed", "cancelled"):
+        return job.state + (f": {job.error}" if job.error else "")
+    if not steps:
+        return f"running: {job.phase}"
+    last = steps[-1]
+    if last["unit"] == units - 1 and last["step"] == last["steps"]:
+        return f"running: {job.phase}"  # every step reached: describing and writing the run
+    unit = f"filament {last['unit'] + 1}/{units}, " if units > 1 else ""
+    ramp = "°C" if last["ramp"] == "temperature" else "(ramp x)"
+    return f"running: {unit}step {last['step']}/{last['steps']} converged at {last['value']:.4g} {ramp}"
+
+
+def _verdict_rows(rows: list[tuple[str, str, str]]) -> list[Any]:
+    return [
+        html.Div(
+            f"step {k}: {label}: {word}" + ("" if text == word else f" — {text}"),
+            className=f"verdict {word.replace(' ', '-')}",
+        )
+        for k, (label, word, text) in enumerate(rows)
+    ]

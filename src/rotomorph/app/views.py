@@ -1,0 +1,256 @@
+"""The page's figures: the lattice's edges to click, predicted shapes, the streamed and final run,
+the toolpath.
+
+The 3-D run view is the run viewer's own figure (:func:`rotomorph.plot.viewer.viewer_figure`:
+Janus tubes, the printed ghost, the slider over temperature, each step's verdict in its title):
+while a simulation runs, the steps received so far are laid out as a
+:class:`~rotomorph.io.results.RunResults` and drawn by it; when the run ends, the results file
+the run wrote is read back (:func:`rotomorph.io.results.read_results`) and drawn, exactly as
+``rotomorph view`` draws it. Every text that comes from a design is escaped
+(:func:`rotomorph._text.markup_safe`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rotomorph._text import markup_safe
+
+__all__ = [
+    "VERDICT_WORDS",
+    "final_figure",
+    "lattice_plan",
+    "partial_results",
+    "step_verdicts",
+    "stream_figure",
+    "toolpath_figure",
+]
+
+EXPANDING_COLOUR = "#d6604d"
+CONTRACTING_COLOUR = "#4393c3"
+
+
+def _go() -> Any:
+    import plotly.graph_objects as go
+
+    return go
+
+
+def lattice_plan(design: Any, modes: list[str], selected: int | None) -> Any:
+    """Plan view of a lattice design's edges, coloured by mode; a marker at each edge's middle
+    carries its index (``customdata``) for clicking; the selected edge drawn thick."""
+    go = _go()
+    lattice = design.lattice.to_lattice()
+    nodes = np.asarray(lattice.network.nodes, dtype=float) + np.asarray(design.lattice.origin)
+    speeds = design.lattice.edge_speeds or [design.lattice.speed] * len(modes)
+    traces = []
+    for mode, colour in (("expanding", EXPANDING_COLOUR), ("contracting", CONTRACTING_COLOUR)):
+        xs: list[float | None] = []
+        ys: list[float | None] = []
+        for j, chain in enumerate(lattice.edge_chains):
+            if modes[j] == mode:
+                pts = nodes[np.asarray(chain)]
+                xs += [*pts[:, 0].tolist(), None]
+                ys += [*pts[:, 1].tolist(), None]
+        traces.append(
+            go.Scatter(
+                x=xs, y=ys, mode="lines", line={"color": colour, "width": 3}, name=mode,
+                hoverinfo="skip",
+            )
+        )  # fmt: skip
+    mids = np.array([nodes[np.asarray(c)][len(c) // 2] for c in lattice.edge_chains])
+    colours = [EXPANDING_COLOUR if m == "expanding" else CONTRACTING_COLOUR for m in modes]
+    sizes = [20 if j == selected else 11 for j in range(len(modes))]
+    traces.append(
+        go.Scatter(
+            x=mids[:, 0],
+            y=mids[:, 1],
+            mode="markers",
+            marker={"color": colours, "size": sizes, "line": {"color": "black", "width": 1.5}},
+            customdata=list(range(len(modes))),
+            text=[f"edge {j}: {m}, {float(v):g} mm/s" for j, (m, v) in enumerate(zip(modes, speeds))],
+            hovertemplate="%{text}<extra></extra>",
+            name="edges (click to edit)",
+        )
+    )
+    fig = go.Figure(traces)
+    fig.update_layout(
+        margin={"l": 40, "r": 10, "t": 60, "b": 40},
+        height=420,
+        xaxis={"title": "x (mm)", "scaleanchor": "y"},
+        yaxis={"title": "y (mm)"},
+        legend={"orientation": "h", "y": 1.0, "yanchor": "bottom"},
+        title={"text": "printed lattice (plan): click an edge's dot to edit it",
+               "font": {"size": 13}, "y": 0.98, "yanchor": "top"},  # fmt: skip
+        clickmode="event",
+    )
+    return fig
+
+
+#: How a step's verdict is named on the page: physical, unstable, not converged, not
+#: admissible (filaments pass through each other or edges strained beyond the rod model), or
+#: unverified (a check was not made).
+VERDICT_WORDS = ("physical", "unstable", "not converged", "not admissible", "unverified")
+
+
+def _word(verdict: Any) -> str:
+    if verdict.verdict == "yes":
+        return "physical"
+    if verdict.verdict == "unknown":
+        return "unverified"
+    text = " ".join(verdict.reasons)
+    if "did not converge" in text:
+        return "not converged"
+    if "unstable" in text:
+        return "unstable"
+    return "not admissible"
+
+
+def step_verdicts(results: Any) -> list[tuple[str, str, str]]:
+    """``(label, word, verdict text)`` per step of ``results`` (:mod:`rotomorph.io.validity`)."""
+    from rotomorph.io.validity import assess
+
+    verdicts = assess(results.scalars, results.metadata, results.n_steps)
+    labels = results.step_labels()
+    return [(labels[k], _word(v), v.text()) for k, v in enumerate(verdicts)]
+
+
+def partial_results(job: Any) -> Any:
+    """The steps a running simulation has streamed, as :class:`RunResults` (None before any).
+
+    Frame after frame in the order received: a design of several filaments is solved one
+    filament at a time, so in the frames of filament i the filaments before it stand at their
+    last state and those after it as printed.
+    """
+    from rotomorph.io.results import RunResults
+
+    topo = job.topology
+    steps = job.step_events()
+    if topo is None or not steps:
+        return None
+    printed = np.asarray(topo["printed"], dtype=float)
+    edges = np.asarray(topo["edges"], dtype=np.int64)
+    units = topo["units"]
+    if topo["chains"]:  # filaments: chains of b - a nodes and b - a - 1 segments each
+        unit_edges = np.cumsum([0] + [b - a - 1 for a, b in units])
+    else:  # a lattice: one unit, the whole network
+        unit_edges = np.array([0, len(edges)])
+    current = printed.copy()
+    normals = np.asarray(topo["normals"], dtype=float).copy()  # as printed until streamed
+    pos, nrm, temp, stable, strain = [], [], [], [], []
+    for ev in steps:
+        a, b = units[ev["unit"]]
+        current[a:b] = ev["positions"]
+        ea, eb = unit_edges[ev["unit"]], unit_edges[ev["unit"] + 1]
+        normals[ea:eb] = ev["normals"]
+        pos.append(current.copy())
+        nrm.append(normals.copy())
+        temp.append(ev["value"])
+        stable.append(np.nan if ev["stable"] is None else float(bool(ev["stable"])))
+        strain.append(ev["max_axial_strain"])
+    ramp = steps[-1]["ramp"]
+    known = np.isfinite(np.stack(nrm)).all(axis=(1, 2))
+    fields = {"active_normal": np.stack(nrm)} if known.all() else {}
+    return RunResults(
+        design={},
+        edges=edges,
+        branch=np.zeros(len(printed), dtype=bool),
+        positions=np.stack(pos),
+        scalars={
+            ramp: np.array(temp),
+            "converged": np.ones(len(pos)),
+            "stable": np.array(stable),
+            "max_axial_strain": np.array(strain),
+        },
+        fields=fields,
+        units={"positions": "mm"},
+        metadata={
+            "contact": bool(topo["contact"]),
+            "chains": topo["chains"],
+            "design_name": str(topo["design_name"]),
+        },
+        static={
+            "radius": np.asarray(topo["radius"], dtype=float),
+            "active_fraction": np.asarray(topo["active_fraction"], dtype=float),
+        },
+    )
+
+
+def stream_figure(job: Any) -> Any:
+    """The run viewer's figure of the steps streamed so far (None before the first)."""
+    from rotomorph.plot.viewer import viewer_figure
+
+    results = partial_results(job)
+    if results is None:
+        return None
+    field = "janus" if "active_normal" in results.fields else "max_axial_strain"
+    if field != "janus":
+        return None
+    return _sized(viewer_figure(results, field=field, facets=8))
+
+
+def final_figure(folder: str | Path) -> tuple[Any, Any]:
+    """The run viewer's figure of a finished run's ``results.h5`` and the results."""
+    from rotomorph.io.results import read_results
+    from rotomorph.plot.viewer import viewer_figure
+
+    results = read_results(Path(folder) / "results.h5")
+    return _sized(viewer_figure(results)), results
+
+
+def _sized(fig: Any) -> Any:
+    fig.update_layout(height=560, uirevision="run")  # the camera stays put as frames arrive
+    return fig
+
+
+def toolpath_figure(programs: list[Any], names: list[str], title: str) -> Any:
+    """Interactive toolpath preview of planned ``programs`` (as printed, in print order).
+
+    Uses the interactive preview of ``rotomorph gcode --preview``
+    (``rotomorph.plot.toolpath_html``) where this installation has it; otherwise a plan view of
+    every layer's paths coloured by the interface angle α (the PNG preview's colouring,
+    :mod:`rotomorph.plot.toolpath`), hovering a point gives filament, layer, α and speed.
+    """
+    try:
+        from rotomorph.plot import toolpath_html  # type: ignore[attr-defined]
+    except ImportError:
+        toolpath_html = None
+    if toolpath_html is not None:
+        return toolpath_html.toolpath_figure(programs, names=names, title=title)
+    go = _go()
+    fig = go.Figure()
+    layers = sorted({p.layer for p in programs})
+    for order, (prog, name) in enumerate(zip(programs, names, strict=True)):
+        alpha = np.degrees(np.mod(prog.interface_angle + np.pi, 2 * np.pi) - np.pi)
+        mid = 0.5 * (prog.points[:-1] + prog.points[1:])
+        fig.add_trace(
+            go.Scatter(
+                x=mid[:, 0],
+                y=mid[:, 1],
+                mode="markers",
+                marker={
+                    "color": alpha,
+                    "colorscale": "Twilight",
+                    "cmin": -180,
+                    "cmax": 180,
+                    "size": 4,
+                    "showscale": order == 0,
+                    "colorbar": {"title": {"text": "α (deg)"}},
+                },
+                customdata=np.stack([alpha, prog.speed[:-1]], axis=1),
+                hovertemplate=f"#{order} {markup_safe(name)} (layer {prog.layer})<br>"
+                "α %{customdata[0]:.0f}°, %{customdata[1]:.3g} mm/s<extra></extra>",
+                showlegend=False,
+            )
+        )
+    fig.update_layout(
+        title={"text": markup_safe(title) + f" — {len(programs)} programs, layers {layers}"},
+        xaxis={"title": "x (mm)", "scaleanchor": "y"},
+        yaxis={"title": "y (mm)"},
+        height=480,
+        margin={"l": 40, "r": 10, "t": 40, "b": 40},
+    )
+    return fig
