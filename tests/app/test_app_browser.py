@@ -134,7 +134,7 @@ def test_dome_edit_simulate_and_print(page, server, tmp_path):
         re.search(r": (physical|unstable|not converged|not admissible|unverified)( —|$)", v)
         for v in verdicts
     )
-    title = pg.locator("#run-view .gtitle").inner_text()
+    title = pg.locator("#run-view .gtitle").text_content() or ""
     assert "(step 4/4)" in title
     rail = pg.locator("#run-view .slider-rail-rect").bounding_box()
     assert rail is not None
@@ -172,9 +172,8 @@ def test_invalid_edit_shows_the_cli_error_next_to_the_field(page, tmp_path, caps
     box = pg.locator('[id*="filaments[0].speed"][id*="field"]')
     box.fill("-2")
     err = pg.locator('[id*="filaments[0].speed"][id*="error"]')
-    pg.wait_for_function(
-        "(el) => el.innerText.length > 0", arg=err.element_handle(), timeout=20_000
-    )
+    playwright_api.expect(err).not_to_have_text("", timeout=20_000)
+    playwright_api.expect(box).to_have_value("-2")  # the field kept what was typed
     shown = err.inner_text()
     # the same design from the file the CLI reads: its one-line error, word for word
     from rotomorph.io.designfile import load_design  # noqa: F401  (the CLI's reader)
@@ -203,6 +202,17 @@ def test_a_5_mb_upload_is_refused(page):
     )
 
 
+HOVER_PIXEL = """(k) => {
+    const gd = document.querySelector('#toolpath .js-plotly-plot');
+    const roles = gd.layout.meta.roles;
+    const trace = roles.map((r, i) => [r[0], i]).filter(r => r[0] === 'hover')[k][1];
+    const t = gd._fullData[trace];
+    const xa = gd._fullLayout[t.xaxis === 'x' ? 'xaxis' : 'xaxis' + t.xaxis.slice(1)];
+    const ya = gd._fullLayout[t.yaxis === 'y' ? 'yaxis' : 'yaxis' + t.yaxis.slice(1)];
+    const box = gd.getBoundingClientRect();
+    const p = Math.floor(t.x.length / 2);
+    return [box.left + xa._offset + xa.l2p(t.x[p]), box.top + ya._offset + ya.l2p(t.y[p])];
+}"""
 MARKUP = "<b>bold</b><img src=x onerror=window.__owned=1><a href='https://evil.example'>x</a>"
 
 
@@ -226,10 +236,29 @@ def test_markup_in_every_text_field_is_inert(page):
     pg.wait_for_function("document.querySelector('#prediction').innerText.includes('f1<b>')")
     pg.click("#preview")
     pg.wait_for_selector("#toolpath .scatterlayer .trace")
-    pg.hover("#toolpath .scatterlayer .trace .points path >> nth=3")
+    names = []
+    pg.locator("#toolpath .main-svg").first.scroll_into_view_if_needed()
+    for k in range(2):  # the mouse on the middle of each filament's hover trace
+        pg.mouse.move(*pg.evaluate(HOVER_PIXEL, k))
+        pg.wait_for_selector("#toolpath .hoverlayer .hovertext", timeout=10_000)
+        names.append(pg.locator("#toolpath .hoverlayer .hovertext").text_content() or "")
+        pg.mouse.move(5, 5)
+    assert ("f0" + MARKUP) in names[0] and ("f1" + MARKUP) in names[1]
+    title = pg.locator("#toolpath .gtitle").text_content() or ""
+    assert title.startswith("n" + MARKUP)
     assert pg.evaluate("window.__owned") is None
     for selector in ("img[src=x]", "a[href*=evil]", "b", "#form b", "#prediction img"):
         assert pg.locator(selector).count() == 0, selector
     assert pg.input_value('[id*="\\"name\\""][id*="field"] >> nth=0') == "n" + MARKUP
     assert ("f0" + MARKUP) in _prediction(pg)
     assert ("n" + MARKUP) in _prediction(pg)
+    pg.fill("#steps", "2")  # the run view's titles and labels too
+    pg.click("#simulate")
+    pg.wait_for_function(
+        "document.querySelector('#job-status').innerText.startsWith('done')", timeout=120_000
+    )
+    shown = pg.locator("#run-view").text_content() or ""  # the design's and filaments' names
+    assert all(name + MARKUP in shown for name in ("n", "f0", "f1"))
+    assert pg.evaluate("window.__owned") is None
+    for selector in ("img[src=x]", "a[href*=evil]", "#run-view b", "#run-view a"):
+        assert pg.locator(selector).count() == 0, selector

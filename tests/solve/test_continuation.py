@@ -73,3 +73,26 @@ def test_other_errors_propagate_and_arguments_are_checked():
         continuation(_solver(1, []), [], 0.0)
     with pytest.raises(InvalidParameterError, match="max_halvings"):
         continuation(_solver(1, []), [1.0], 0.0, max_halvings=-1)
+
+
+def test_on_step_reports_each_requested_value_once_in_order_as_it_is_reached():
+    calls: list = []
+    seen: list = []
+
+    def on_step(step) -> None:
+        seen.append((step.parameter, step.result.state, len(calls)))
+
+    res = continuation(_solver(0.3, calls), [0.5, 1.0], 0.0, start=0.0, on_step=on_step)
+    # halved sub-steps are not reported; each value as soon as it is reached (not at the end)
+    assert [s[0] for s in seen] == [0.5, 1.0]
+    assert [s[1] for s in seen] == [0.5, 1.0]
+    assert seen[0][2] < len(calls)  # the first report came before the second step's solves
+    assert [s.parameter for s in res.steps] == [0.5, 1.0]
+
+
+def test_an_exception_in_on_step_propagates():
+    def on_step(step) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        continuation(_solver(1.0, []), [0.5, 1.0], 0.0, start=0.0, on_step=on_step)

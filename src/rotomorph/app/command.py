@@ -57,16 +57,30 @@ def command(args: argparse.Namespace) -> int:
             "serve", f"the app needs its extra: pip install 'rotomorph[app]' ({err})"
         ) from None
     from rotomorph.app.jobs import Sessions
+    from rotomorph.app.server import LOCAL_HOSTS
 
-    app, sessions = create_app(examples=examples, sessions=Sessions(max_jobs=args.max_jobs))
+    local = args.host in LOCAL_HOSTS
+    app, sessions = create_app(
+        examples=examples,
+        sessions=Sessions(max_jobs=args.max_jobs),
+        allowed_hosts=LOCAL_HOSTS if local else None,
+    )
     from werkzeug.serving import make_server
 
-    server = make_server(args.host, args.port, app.server, threaded=True)
-    url = f"http://{args.host if args.host != '0.0.0.0' else '127.0.0.1'}:{server.server_port}/"
+    try:
+        server = make_server(args.host, args.port, app.server, threaded=True)
+    except (OSError, ValueError) as err:  # port taken, address not of this computer
+        sessions.close()
+        reason = getattr(err, "strerror", None) or str(err)
+        raise InvalidParameterError(
+            "--host/--port", f"cannot listen on {args.host}:{args.port}: {reason}; pick another"
+        ) from None
+    shown = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(args.host, args.host)
+    url = f"http://{f'[{shown}]' if ':' in shown else shown}:{server.server_port}/"
     logging.getLogger("werkzeug").setLevel(logging.WARNING)
     sys.stderr.write(f"rotomorph: serving the designer at {url} (Ctrl-C stops it)\n")
     sys.stderr.flush()
-    if args.host not in ("127.0.0.1", "localhost", "::1"):
+    if not local:
         sys.stderr.write(
             f"rotomorph: warning: listening on {args.host}: anyone who reaches it can use it "
             "(there is no login)\n"

@@ -3,8 +3,11 @@
 Every file is written by the function the command line uses, into a temporary folder the
 server chose, and offered as those bytes:
 
-* the design file: :func:`rotomorph.io.designfile.save_design` (as ``rotomorph inverse`` and
-  the Python API write it);
+* the design file: the design's tables as the page holds them, written as TOML
+  (``tomli_w``, as :func:`rotomorph.io.designfile.save_design` writes), after the same
+  validation as ``rotomorph validate``; values the person left unset stay unset (the nozzle's
+  placeholder pressures and dwells are still flagged in the G-code made from the file, where
+  ``save_design`` would write every default out);
 * the G-code: the steps of ``rotomorph gcode DESIGN -o FILE [--machine PROFILE]`` —
   :func:`~rotomorph.io.gcode.check_materials`, :func:`~rotomorph.io.placement.check_placement`,
   :func:`~rotomorph.io.gcode.write_gcode` with the design's
@@ -28,6 +31,8 @@ import zipfile
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
+
+from rotomorph.errors import InvalidParameterError
 
 __all__ = [
     "BUILTIN_MACHINES",
@@ -82,12 +87,22 @@ def machine_profile(choice: str, examples: list[Path], uploaded: Any) -> Any:
     raise InvalidParameterError("machine", f"unknown machine choice {choice!r}; pick one listed")
 
 
-def design_bytes(design: Any) -> bytes:
-    """The design file :func:`~rotomorph.io.designfile.save_design` writes for ``design``."""
-    from rotomorph.io.designfile import save_design
+def design_bytes(data: dict[str, Any]) -> bytes:
+    """The design file of ``data`` (the tables a design file parses into): TOML, UTF-8.
 
-    with tempfile.TemporaryDirectory(prefix="rotomorph-app-") as tmp:
-        return save_design(design, Path(tmp) / "design.toml").read_bytes()
+    Raises
+    ------
+    InvalidParameterError
+        ``data`` is not a valid design (the message ``rotomorph validate`` prints).
+    """
+    import tomli_w
+
+    from rotomorph.app.editing import check
+
+    design, error = check(data)
+    if error is not None:
+        raise InvalidParameterError(error[0], error[1].removeprefix(f"{error[0]}: "))
+    return tomli_w.dumps(data).encode("utf-8")
 
 
 def gcode_bytes(design: Any, machine: Any, *, cure: float = 0.0) -> tuple[bytes, dict[str, bytes]]:

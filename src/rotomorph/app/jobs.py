@@ -19,6 +19,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import queue
+import re
 import shutil
 import tempfile
 import threading
@@ -27,7 +28,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Job", "Sessions", "Worker"]
+from rotomorph.errors import InvalidParameterError
+
+__all__ = ["BusyError", "Job", "Sessions", "Worker"]
+
+class BusyError(RuntimeError):
+    """The session already runs a job, or the server's caps are reached (the message says)."""
+
+
+#: A session id as the page gets it (``uuid4().hex``); anything else is refused.
+_SID = re.compile(r"[0-9a-f]{32}")
 
 
 @dataclass
@@ -195,6 +205,8 @@ class Sessions:
         self._lock = threading.RLock()
 
     def _get(self, sid: str) -> _Session:
+        if not (isinstance(sid, str) and _SID.fullmatch(sid)):
+            raise InvalidParameterError("session", "is not a session of this server; reload the page")
         with self._lock:
             self._reap()
             session = self._sessions.setdefault(sid, _Session())
@@ -214,7 +226,7 @@ class Sessions:
                 if len(holders) >= self.max_workers:
                     idle = [s for s in holders if not (s.worker and s.worker.job and s.worker.job.running)]
                     if not idle:
-                        raise RuntimeError(
+                        raise BusyError(
                             f"{self.max_workers} sessions are computing; try again when one ends"
                         )
                     oldest = min(idle, key=lambda s: s.seen)
@@ -245,7 +257,7 @@ class Sessions:
 
         Raises
         ------
-        RuntimeError
+        BusyError
             The session already runs a job, or the cap on running jobs is reached (the
             message says so).
         """
@@ -253,9 +265,9 @@ class Sessions:
             worker = self.worker(sid)
             current = worker.poll()
             if current is not None and current.running:
-                raise RuntimeError("a job is running in this session; cancel it or wait")
+                raise BusyError("a job is running in this session; cancel it or wait")
             if self.running() >= self.max_jobs:
-                raise RuntimeError(
+                raise BusyError(
                     f"{self.max_jobs} job(s) are running (the limit of this server); "
                     "try again when one ends"
                 )

@@ -272,6 +272,7 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
                     dcc.Dropdown(
                         id="example",
                         options=[{"label": label, "value": v} for v, label in examples],
+                        value=examples[0][0] if examples else None,
                         placeholder="open an example design…",
                         className="example",
                     ),

@@ -11,15 +11,17 @@ from __future__ import annotations
 
 import base64
 import binascii
+import logging
 import uuid
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import dash
 from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
 
 from rotomorph.app import editing, files, views
-from rotomorph.app.jobs import Job, Sessions
+from rotomorph.app.jobs import BusyError, Job, Sessions
 from rotomorph.app.layout import TARGETS, page, render_form
 from rotomorph.errors import InvalidParameterError, MachineLimitError, RotomorphError
 from rotomorph.io.tomlfile import MAX_TOML_BYTES
@@ -27,6 +29,7 @@ from rotomorph.io.tomlfile import MAX_TOML_BYTES
 __all__ = ["create_app"]
 
 _STYLE = Path(__file__).with_name("style.css")
+_log = logging.getLogger(__name__)
 
 # The browser refuses an upload over the limit before sending it, in the CLI's words
 # (rotomorph.io.tomlfile.decode_toml_bytes); the server checks again (MAX_CONTENT_LENGTH and
@@ -46,6 +49,11 @@ function(contents, name) {
 """ % (MAX_TOML_BYTES, MAX_TOML_BYTES)
 
 
+#: Names of this computer's loopback interface (the default ``--host 127.0.0.1``).
+LOCAL_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
+_TEXT = {"Content-Type": "text/plain; charset=utf-8"}
+
+
 def _decode(contents: str) -> bytes:
     _, _, b64 = contents.partition(",")
     try:
@@ -61,9 +69,17 @@ def _message(err: BaseException) -> str:
 
 
 def create_app(
-    *, examples: Path | None = None, sessions: Sessions | None = None
+    *,
+    examples: Path | None = None,
+    sessions: Sessions | None = None,
+    allowed_hosts: frozenset[str] | None = LOCAL_HOSTS,
 ) -> tuple[Dash, Sessions]:
     """The Dash app and its sessions.
+
+    Every request's ``Host`` must name one of ``allowed_hosts`` (a page elsewhere on the web
+    that resolves its own name to this computer cannot drive the app: DNS rebinding), bodies
+    are limited to twice the design-file limit, and a refused or failed request is answered
+    with one line of text (never a traceback).
 
     Parameters
     ----------
@@ -72,6 +88,9 @@ def create_app(
         page offers (the repository's ``examples/``); None: none (uploads and built-ins only).
     sessions
         Session registry (caps on jobs and workers); default :class:`Sessions`.
+    allowed_hosts
+        Host names the page may be reached by (default: this computer's loopback names);
+        None: any (``rotomorph serve --host`` other than loopback).
     """
     sessions = sessions or Sessions()
     designs = files.list_toml(examples / "designs" if examples else None)
@@ -83,7 +102,7 @@ def create_app(
     app = Dash(
         __name__,
         title="rotomorph designer",
-        update_title=None,
+        update_title="",
         suppress_callback_exceptions=True,
         serve_locally=True,
     )
@@ -92,6 +111,7 @@ def create_app(
         "{%css%}", "{%css%}<style>" + _STYLE.read_text(encoding="utf-8") + "</style>"
     )
     app.layout = lambda: page(uuid.uuid4().hex, example_choices, machine_choices)
+    _guard(app.server, allowed_hosts)
 
     def design_of(data: Any) -> Any:
         design, error = editing.check(data or {})
@@ -125,7 +145,10 @@ def create_app(
         from rotomorph.io.designfile import parse_design_bytes
         from rotomorph.io.tomlfile import decode_toml_bytes
 
-        sessions.worker(sid)  # warm the session's worker while the person designs
+        try:
+            sessions.worker(sid)  # warm the session's worker while the person designs
+        except BusyError:
+            pass  # every worker computing: this session gets one when it submits a job
         trigger = ctx.triggered_id
         if trigger == "upload-checked" and upload:
             name = str(upload.get("name") or "upload")
@@ -282,7 +305,7 @@ def create_app(
             check_run_options("lattice" if design.lattice else "filaments", steps=count)
             sessions.submit(sid, Job("simulate", steps=int(count)),
                             {"kind": "simulate", "design": data, "steps": int(count)})  # fmt: skip
-        except (RotomorphError, RuntimeError) as err:
+        except (RotomorphError, BusyError) as err:
             return f"not started: {_message(err)}", no_update
         return "starting…", False
 
@@ -303,7 +326,7 @@ def create_app(
             parse_target_bytes(raw, "target")  # refused as `rotomorph inverse` refuses a file
             sessions.submit(sid, Job("inverse"),
                             {"kind": "inverse", "target": decode_toml_bytes(raw, "target")})  # fmt: skip
-        except (RotomorphError, RuntimeError) as err:
+        except (RotomorphError, BusyError) as err:
             return f"not started: {_message(err)}", no_update
         return "designing…", False
 
@@ -356,7 +379,8 @@ def create_app(
         value = sum(1 for e in steps if e["step"] >= 0)
         units = steps[-1]["units"] if steps else 1
         status = _status(job, steps, units)
-        generation, verdicts = no_update, no_update
+        generation: Any = no_update
+        verdicts: Any = no_update
         if job.generation != drawn:  # something new: the view is drawn by `draw`
             generation = job.generation
             if job.state == "done" and job.result:
@@ -402,7 +426,7 @@ def create_app(
         except RotomorphError as err:
             return no_update, _message(err)
         name = _file_name(design.name, "design") + ".toml"
-        return dcc.send_bytes(files.design_bytes(design), name), ""
+        return dcc.send_bytes(files.design_bytes(data), name), ""
 
     @app.callback(
         Output("machine", "options"),
@@ -470,9 +494,8 @@ def create_app(
             planned = plan_programs(design.to_programs(), machine)
         except RotomorphError as err:
             return no_update, _message(err)
-        names = [f"layer {p.layer}" for p in planned]
-        title = f"{design.name or 'design'} on {machine.name}"
-        return views.toolpath_figure(planned, names, title), ""
+        title = f"{design.name or 'design'} on {machine.name}"  # as `gcode --preview` titles it
+        return views.toolpath_figure(planned, design.program_names(), title, machine.lift), ""
 
     @app.callback(
         Output("run-file", "data"),
@@ -494,6 +517,46 @@ def create_app(
         return dcc.send_bytes(files.folder_zip(folder), "run.zip")
 
     return app, sessions
+
+
+def _guard(server: Any, allowed_hosts: frozenset[str] | None) -> None:
+    """Host check, safe headers and one-line errors on the Flask server."""
+    from flask import request
+    from werkzeug.exceptions import HTTPException
+
+    @server.before_request
+    def check_host() -> Any:
+        if allowed_hosts is None:
+            return None
+        try:
+            host = urlsplit("//" + (request.host or "")).hostname
+        except ValueError:
+            host = None
+        if host not in allowed_hosts:
+            return ("rotomorph serve: refused: this server answers only to "
+                    f"{', '.join(sorted(allowed_hosts))}\n", 403, _TEXT)  # fmt: skip
+        return None
+
+    @server.after_request
+    def headers(response: Any) -> Any:
+        response.headers["X-Content-Type-Options"] = "nosniff"
+        response.headers["X-Frame-Options"] = "DENY"
+        response.headers["Referrer-Policy"] = "no-referrer"
+        return response
+
+    @server.errorhandler(HTTPException)
+    def http_error(err: HTTPException) -> Any:
+        return f"rotomorph serve: {err.code} {err.name}: {err.description}\n", err.code, _TEXT
+
+    @server.errorhandler(RotomorphError)
+    def bad_input(err: RotomorphError) -> Any:
+        return f"rotomorph serve: {_message(err)}\n", 400, _TEXT
+
+    @server.errorhandler(Exception)
+    def internal(err: Exception) -> Any:
+        _log.error("request failed", exc_info=err)  # the traceback stays in the server's log
+        return (f"rotomorph serve: internal error ({type(err).__name__}); "
+                "the server's log has the details\n", 500, _TEXT)  # fmt: skip
 
 
 def _cure(text: Any) -> float:

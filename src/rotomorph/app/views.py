@@ -1,13 +1,13 @@
-"""The page's figures: the lattice's edges to click, predicted shapes, the streamed and final run,
-the toolpath.
+"""The page's figures: the lattice's edges to click, the streamed and final run, the toolpath.
 
 The 3-D run view is the run viewer's own figure (:func:`rotomorph.plot.viewer.viewer_figure`:
 Janus tubes, the printed ghost, the slider over temperature, each step's verdict in its title):
 while a simulation runs, the steps received so far are laid out as a
 :class:`~rotomorph.io.results.RunResults` and drawn by it; when the run ends, the results file
 the run wrote is read back (:func:`rotomorph.io.results.read_results`) and drawn, exactly as
-``rotomorph view`` draws it. Every text that comes from a design is escaped
-(:func:`rotomorph._text.markup_safe`).
+``rotomorph view`` draws it. The toolpath is ``rotomorph gcode --preview``'s figure. Texts
+from a design reach plotly only through those figures, which escape them; the plan view here
+shows numbers only.
 """
 
 from __future__ import annotations
@@ -16,8 +16,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-from rotomorph._text import markup_safe
 
 __all__ = [
     "VERDICT_WORDS",
@@ -206,51 +204,17 @@ def _sized(fig: Any) -> Any:
     return fig
 
 
-def toolpath_figure(programs: list[Any], names: list[str], title: str) -> Any:
-    """Interactive toolpath preview of planned ``programs`` (as printed, in print order).
+def toolpath_figure(programs: list[Any], names: list[str], title: str, lift: float | None) -> Any:
+    """The interactive toolpath preview of ``rotomorph gcode --preview``
+    (:func:`rotomorph.plot.toolpath_html.toolpath_figure`) of planned ``programs``: names and
+    title shown escaped, ``lift`` the machine's travel height (mm)."""
+    from rotomorph.plot.toolpath_html import toolpath_figure as figure
 
-    Uses the interactive preview of ``rotomorph gcode --preview``
-    (``rotomorph.plot.toolpath_html``) where this installation has it; otherwise a plan view of
-    every layer's paths coloured by the interface angle α (the PNG preview's colouring,
-    :mod:`rotomorph.plot.toolpath`), hovering a point gives filament, layer, α and speed.
-    """
-    try:
-        from rotomorph.plot import toolpath_html  # type: ignore[attr-defined]
-    except ImportError:
-        toolpath_html = None
-    if toolpath_html is not None:
-        return toolpath_html.toolpath_figure(programs, names=names, title=title)
-    go = _go()
-    fig = go.Figure()
-    layers = sorted({p.layer for p in programs})
-    for order, (prog, name) in enumerate(zip(programs, names, strict=True)):
-        alpha = np.degrees(np.mod(prog.interface_angle + np.pi, 2 * np.pi) - np.pi)
-        mid = 0.5 * (prog.points[:-1] + prog.points[1:])
-        fig.add_trace(
-            go.Scatter(
-                x=mid[:, 0],
-                y=mid[:, 1],
-                mode="markers",
-                marker={
-                    "color": alpha,
-                    "colorscale": "Twilight",
-                    "cmin": -180,
-                    "cmax": 180,
-                    "size": 4,
-                    "showscale": order == 0,
-                    "colorbar": {"title": {"text": "α (deg)"}},
-                },
-                customdata=np.stack([alpha, prog.speed[:-1]], axis=1),
-                hovertemplate=f"#{order} {markup_safe(name)} (layer {prog.layer})<br>"
-                "α %{customdata[0]:.0f}°, %{customdata[1]:.3g} mm/s<extra></extra>",
-                showlegend=False,
-            )
-        )
+    fig = figure(programs, names=names, title=title, lift=lift)
+    # in a panel narrower than the preview page: the title on top, the colouring menu below it
     fig.update_layout(
-        title={"text": markup_safe(title) + f" — {len(programs)} programs, layers {layers}"},
-        xaxis={"title": "x (mm)", "scaleanchor": "y"},
-        yaxis={"title": "y (mm)"},
-        height=480,
-        margin={"l": 40, "r": 10, "t": 40, "b": 40},
+        title={"y": 0.995, "yanchor": "top", "font": {"size": 13}},
+        margin={"t": 130},
+        uirevision="toolpath",
     )
     return fig
