@@ -1,6 +1,6 @@
 """Imports flow one way: design -> materials -> rod -> contact -> solve -> analysis ->
-lattice -> io -> plot -> simulate -> inverse | sweep | prediction -> app -> cli; errors, type aliases
-and geometry sit below all."""
+lattice -> io -> plot -> simulate -> inverse | sweep | prediction -> app -> cli; errors, type
+aliases and geometry sit below all."""
 
 from __future__ import annotations
 

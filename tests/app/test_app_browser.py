@@ -40,8 +40,19 @@ SHOT = os.environ.get("ROTOMORPH_APP_SCREENSHOTS") == "1"  # rewrite docs/images
 @pytest.fixture(scope="module")
 def server():
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rotomorph", "serve", "--no-open", "--port", "0",
-         "--examples", str(ROOT / "examples"), "--max-jobs", "2"],  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "rotomorph",
+            "serve",
+            "--no-open",
+            "--port",
+            "0",
+            "--examples",
+            str(ROOT / "examples"),
+            "--max-jobs",
+            "2",
+        ],
         stderr=subprocess.PIPE,
         stdout=subprocess.DEVNULL,
         text=True,
@@ -79,8 +90,11 @@ def page(browser, server):
 
 def _open_example(pg, name: str) -> None:
     pg.click("#example")
-    pg.click(f".Select-menu-outer >> text={name}" if pg.locator(".Select-menu-outer").count()
-             else f"text={name}")  # fmt: skip
+    pg.click(
+        f".Select-menu-outer >> text={name}"
+        if pg.locator(".Select-menu-outer").count()
+        else f"text={name}"
+    )
     pg.wait_for_function(
         f"document.querySelector('#prediction').innerText.includes(\"'{name}'\")", timeout=30_000
     )
@@ -176,8 +190,9 @@ def test_invalid_edit_shows_the_cli_error_next_to_the_field(page, tmp_path, caps
     playwright_api.expect(box).to_have_value("-2")  # the field kept what was typed
     shown = err.inner_text()
     # the same design from the file the CLI reads: its one-line error, word for word
-    from rotomorph.io.designfile import load_design  # noqa: F401  (the CLI's reader)
     import tomllib
+
+    from rotomorph.io.designfile import load_design  # noqa: F401  (the CLI's reader)
 
     data = tomllib.loads((ROOT / "examples/designs/composite_rotation.toml").read_text())
     data["filaments"][0]["speed"] = -2
@@ -223,15 +238,21 @@ def test_markup_in_every_text_field_is_inert(page):
         "name": "n" + MARKUP,
         "description": "d" + MARKUP,
         "filaments": [
-            {"name": f"f{i}" + MARKUP, "rotation_number": 0.25, "spacing": 0.5,
-             "start": [10.0, 10.0 + 5 * i, 0.0], "segments": [{"kind": "line", "length": 8.0}]}
+            {
+                "name": f"f{i}" + MARKUP,
+                "rotation_number": 0.25,
+                "spacing": 0.5,
+                "start": [10.0, 10.0 + 5 * i, 0.0],
+                "segments": [{"kind": "line", "length": 8.0}],
+            }
             for i in range(2)
-        ],  # fmt: skip
+        ],
     }
     pg.set_input_files(
         "#upload input[type=file]",
-        files=[{"name": "markup.toml", "mimeType": "text/plain",
-                "buffer": tomli_w.dumps(doc).encode()}],  # fmt: skip
+        files=[
+            {"name": "markup.toml", "mimeType": "text/plain", "buffer": tomli_w.dumps(doc).encode()}
+        ],
     )
     pg.wait_for_function("document.querySelector('#prediction').innerText.includes('f1<b>')")
     pg.click("#preview")

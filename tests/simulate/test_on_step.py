@@ -15,10 +15,14 @@ def _filaments():
         {
             "schema_version": 1,
             "filaments": [
-                {"rotation_number": 0.25, "spacing": 1.0, "start": [0.0, 5.0 * i, 0.0],
-                 "segments": [{"kind": "line", "length": 8.0}]}
+                {
+                    "rotation_number": 0.25,
+                    "spacing": 1.0,
+                    "start": [0.0, 5.0 * i, 0.0],
+                    "segments": [{"kind": "line", "length": 8.0}],
+                }
                 for i in range(2)
-            ],  # fmt: skip
+            ],
         }
     )
 
@@ -42,9 +46,15 @@ def test_a_lattice_streams_its_ramp_in_the_lab_frame():
     design = parse_design(
         {
             "schema_version": 1,
-            "lattice": {"n": 3, "spacing": 5.0, "amplitude": 1.0, "pattern": "dome",
-                        "ghost_nodes": 4, "origin": [10.0, 20.0, 0.0]},
-        }  # fmt: skip
+            "lattice": {
+                "n": 3,
+                "spacing": 5.0,
+                "amplitude": 1.0,
+                "pattern": "dome",
+                "ghost_nodes": 4,
+                "origin": [10.0, 20.0, 0.0],
+            },
+        }
     )
     seen: list[StepReport] = []
     sim = simulate_design(design, steps=2, on_step=seen.append)

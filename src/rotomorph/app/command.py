@@ -65,16 +65,20 @@ def command(args: argparse.Namespace) -> int:
         sessions=Sessions(max_jobs=args.max_jobs),
         allowed_hosts=LOCAL_HOSTS if local else None,
     )
+    import socket
+
     from werkzeug.serving import make_server
 
-    try:
-        server = make_server(args.host, args.port, app.server, threaded=True)
-    except (OSError, ValueError) as err:  # port taken, address not of this computer
+    try:  # bound here: werkzeug would print its own words and exit on a taken port
+        family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
+        listener = socket.create_server((args.host, args.port), family=family)
+    except (OSError, ValueError, OverflowError) as err:  # port taken, not this computer's
         sessions.close()
         reason = getattr(err, "strerror", None) or str(err)
         raise InvalidParameterError(
             "--host/--port", f"cannot listen on {args.host}:{args.port}: {reason}; pick another"
         ) from None
+    server = make_server(args.host, args.port, app.server, threaded=True, fd=listener.fileno())
     shown = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(args.host, args.host)
     url = f"http://{f'[{shown}]' if ':' in shown else shown}:{server.server_port}/"
     logging.getLogger("werkzeug").setLevel(logging.WARNING)

@@ -12,6 +12,7 @@ materials and the built-in machine's placement), returning the one-line error wi
 from __future__ import annotations
 
 import copy
+import itertools
 import math
 import re
 from typing import Any
@@ -76,7 +77,7 @@ def set_field(data: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
     out = copy.deepcopy(data)
     parts = _parts(path)
     node: Any = out
-    for part, nxt in zip(parts[:-1], parts[1:], strict=True):
+    for part, nxt in itertools.pairwise(parts):
         if isinstance(part, int):
             node = node[part]
             continue

@@ -99,7 +99,7 @@ def design_bytes(data: dict[str, Any]) -> bytes:
 
     from rotomorph.app.editing import check
 
-    design, error = check(data)
+    _, error = check(data)
     if error is not None:
         raise InvalidParameterError(error[0], error[1].removeprefix(f"{error[0]}: "))
     return tomli_w.dumps(data).encode("utf-8")

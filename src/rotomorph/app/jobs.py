@@ -32,6 +32,7 @@ from rotomorph.errors import InvalidParameterError
 
 __all__ = ["BusyError", "Job", "Sessions", "Worker"]
 
+
 class BusyError(RuntimeError):
     """The session already runs a job, or the server's caps are reached (the message says)."""
 
@@ -206,7 +207,9 @@ class Sessions:
 
     def _get(self, sid: str) -> _Session:
         if not (isinstance(sid, str) and _SID.fullmatch(sid)):
-            raise InvalidParameterError("session", "is not a session of this server; reload the page")
+            raise InvalidParameterError(
+                "session", "is not a session of this server; reload the page"
+            )
         with self._lock:
             self._reap()
             session = self._sessions.setdefault(sid, _Session())
@@ -224,7 +227,11 @@ class Sessions:
             if session.worker is None:
                 holders = [s for s in self._sessions.values() if s.worker is not None]
                 if len(holders) >= self.max_workers:
-                    idle = [s for s in holders if not (s.worker and s.worker.job and s.worker.job.running)]
+                    idle = [
+                        s
+                        for s in holders
+                        if not (s.worker and s.worker.job and s.worker.job.running)
+                    ]
                     if not idle:
                         raise BusyError(
                             f"{self.max_workers} sessions are computing; try again when one ends"
@@ -248,7 +255,9 @@ class Sessions:
             return sum(
                 1
                 for s in self._sessions.values()
-                if s.worker is not None and s.worker.job is not None and s.worker.poll() is not None
+                if s.worker is not None
+                and s.worker.job is not None
+                and s.worker.poll() is not None
                 and s.worker.job.running
             )
 

@@ -244,7 +244,9 @@ def placeholder(text: str) -> dict[str, Any]:
             "xaxis": {"visible": False},
             "yaxis": {"visible": False},
             "margin": {"l": 0, "r": 0, "t": 0, "b": 0},
-            "annotations": [{"text": text, "showarrow": False, "font": {"size": 13, "color": "#777"}}],
+            "annotations": [
+                {"text": text, "showarrow": False, "font": {"size": 13, "color": "#777"}}
+            ],
         },
     }
 
@@ -393,8 +395,9 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
                                         [
                                             html.Button("preview toolpath", id="preview"),
                                             html.Button("G-code", id="get-gcode"),
-                                            html.Button("controller configuration (.zip)",
-                                                        id="get-config"),  # fmt: skip
+                                            html.Button(
+                                                "controller configuration (.zip)", id="get-config"
+                                            ),
                                             dcc.Download(id="gcode-file"),
                                         ],
                                         className="row",
@@ -417,14 +420,19 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
                                         clearable=False,
                                     ),
                                     dcc.Textarea(
-                                        id="target-text", value=TARGETS["helix"], rows=12,
+                                        id="target-text",
+                                        value=TARGETS["helix"],
+                                        rows=12,
                                         className="target",
-                                    ),  # fmt: skip
+                                    ),
                                     html.Div(
                                         [
                                             html.Button("design it", id="inverse"),
-                                            html.Button("open the result as the design",
-                                                        id="inverse-open", disabled=True),  # fmt: skip
+                                            html.Button(
+                                                "open the result as the design",
+                                                id="inverse-open",
+                                                disabled=True,
+                                            ),
                                         ],
                                         className="row",
                                     ),

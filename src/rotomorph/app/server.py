@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-import dash
 from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
 
 from rotomorph.app import editing, files, views
@@ -41,12 +40,12 @@ function(contents, name) {
     var b64 = contents.length - comma - 1;
     var pad = contents.endsWith("==") ? 2 : (contents.endsWith("=") ? 1 : 0);
     var bytes = Math.floor(b64 * 3 / 4) - pad;
-    if (bytes > %d) {
-        return [null, name + ": is " + bytes + " bytes; the limit is %d bytes for a TOML file"];
+    if (bytes > LIMIT) {
+        return [null, name + ": is " + bytes + " bytes; the limit is LIMIT bytes for a TOML file"];
     }
     return [{"name": name, "contents": contents}, ""];
 }
-""" % (MAX_TOML_BYTES, MAX_TOML_BYTES)
+""".replace("LIMIT", str(MAX_TOML_BYTES))
 
 
 #: Names of this computer's loopback interface (the default ``--host 127.0.0.1``).
@@ -163,9 +162,16 @@ def create_app(
             return inverse, render_form(inverse), ""
         index = example if example is not None else "0" if designs else None
         if index is None or not str(index).isdigit() or int(index) >= len(designs):
-            data = {"schema_version": 1, "filaments": [
-                {"name": "filament", "rotation_number": 0.25,
-                 "segments": [{"kind": "line", "length": 30.0}]}]}  # fmt: skip
+            data = {
+                "schema_version": 1,
+                "filaments": [
+                    {
+                        "name": "filament",
+                        "rotation_number": 0.25,
+                        "segments": [{"kind": "line", "length": 30.0}],
+                    }
+                ],
+            }
             return data, render_form(data), ""
         path = designs[int(index)]
         data = decode_toml_bytes(path.read_bytes(), path.name)
@@ -231,7 +237,13 @@ def create_app(
                 errors[paths.index(where)] = error[1]
             else:
                 shown = error[1]
-            return errors, shown, [html.Div("prediction waits for a valid design")], no_update, no_update
+            return (
+                errors,
+                shown,
+                [html.Div("prediction waits for a valid design")],
+                no_update,
+                no_update,
+            )
         pred = predict_design(design)
         lines = [f"'{pred.name}' at {pred.temperature:g} °C (± calibration band)", *pred.lines()]
         prediction = [html.Div(line, className="prediction-line") for line in lines]
@@ -274,13 +286,17 @@ def create_app(
     def edit_edge(mode: Any, speed: Any, edge: Any, data: Any) -> Any:
         if edge is None:
             return no_update, no_update
-        design, error = editing.check(data)
+        design, _ = editing.check(data)
         if design is None or design.lattice is None:
             return no_update, no_update
         modes = editing.edge_modes(design.lattice)
         speeds = design.lattice.edge_speeds or [design.lattice.speed] * len(modes)
         new_mode = mode if mode != modes[edge] else None
-        new_speed = speed if speed not in (None, "") and editing.parse_value(speed) != speeds[edge] else None
+        new_speed = (
+            speed
+            if speed not in (None, "") and editing.parse_value(speed) != speeds[edge]
+            else None
+        )
         if new_mode is None and new_speed is None:
             return no_update, no_update
         new = editing.set_edge(data, modes, edge, mode=new_mode, speed=new_speed)
@@ -303,8 +319,11 @@ def create_app(
             design = design_of(data)
             count = editing.parse_value(steps)
             check_run_options("lattice" if design.lattice else "filaments", steps=count)
-            sessions.submit(sid, Job("simulate", steps=int(count)),
-                            {"kind": "simulate", "design": data, "steps": int(count)})  # fmt: skip
+            sessions.submit(
+                sid,
+                Job("simulate", steps=int(count)),
+                {"kind": "simulate", "design": data, "steps": int(count)},
+            )
         except (RotomorphError, BusyError) as err:
             return f"not started: {_message(err)}", no_update
         return "starting…", False
@@ -324,8 +343,9 @@ def create_app(
         raw = str(text or "").encode("utf-8")
         try:
             parse_target_bytes(raw, "target")  # refused as `rotomorph inverse` refuses a file
-            sessions.submit(sid, Job("inverse"),
-                            {"kind": "inverse", "target": decode_toml_bytes(raw, "target")})  # fmt: skip
+            sessions.submit(
+                sid, Job("inverse"), {"kind": "inverse", "target": decode_toml_bytes(raw, "target")}
+            )
         except (RotomorphError, BusyError) as err:
             return f"not started: {_message(err)}", no_update
         return "designing…", False
@@ -368,10 +388,12 @@ def create_app(
         job = sessions.job(sid)
         keep = [no_update] * 10
         if job is None:
-            return keep[:6] + [True] + keep[7:]
+            return [*keep[:6], True, *keep[7:]]
         if job.kind == "inverse":
             done = not job.running
-            status = job.phase if job.running else job.state + (f": {job.error}" if job.error else "")
+            status = (
+                job.phase if job.running else job.state + (f": {job.error}" if job.error else "")
+            )
             design = job.result["design"] if job.state == "done" and job.result else no_update
             return (*keep[:6], done, status, design, job.state != "done")
         steps = job.step_events()
@@ -393,8 +415,16 @@ def create_app(
                 if partial is not None:
                     verdicts = _verdict_rows(views.step_verdicts(partial))
         maximum = total * units
-        return (str(min(value, maximum)), str(maximum), status, generation, verdicts,
-                job.generation, not job.running, *keep[7:])  # fmt: skip
+        return (
+            str(min(value, maximum)),
+            str(maximum),
+            status,
+            generation,
+            verdicts,
+            job.generation,
+            not job.running,
+            *keep[7:],
+        )
 
     @app.callback(
         Output("run-view", "figure"),
@@ -465,8 +495,7 @@ def create_app(
     def get_gcode(_g: Any, _c: Any, data: Any, choice: Any, cure: Any, sid: str) -> Any:
         try:
             design = design_of(data)
-            program, config = files.gcode_bytes(design, machine_of(choice, sid),
-                                                cure=_cure(cure))  # fmt: skip
+            program, config = files.gcode_bytes(design, machine_of(choice, sid), cure=_cure(cure))
         except RotomorphError as err:
             return no_update, _message(err)
         name = _file_name(design.name, "design")
@@ -533,8 +562,12 @@ def _guard(server: Any, allowed_hosts: frozenset[str] | None) -> None:
         except ValueError:
             host = None
         if host not in allowed_hosts:
-            return ("rotomorph serve: refused: this server answers only to "
-                    f"{', '.join(sorted(allowed_hosts))}\n", 403, _TEXT)  # fmt: skip
+            return (
+                "rotomorph serve: refused: this server answers only to "
+                f"{', '.join(sorted(allowed_hosts))}\n",
+                403,
+                _TEXT,
+            )
         return None
 
     @server.after_request
@@ -554,9 +587,38 @@ def _guard(server: Any, allowed_hosts: frozenset[str] | None) -> None:
 
     @server.errorhandler(Exception)
     def internal(err: Exception) -> Any:
+        if _malformed(err):  # the page never sends this: a forged or truncated request
+            _log.warning("bad request: %s: %s", type(err).__name__, err)
+            return (
+                f"rotomorph serve: 400 Bad Request: the request does not fit this page "
+                f"({type(err).__name__}); reload the page\n",
+                400,
+                _TEXT,
+            )
         _log.error("request failed", exc_info=err)  # the traceback stays in the server's log
-        return (f"rotomorph serve: internal error ({type(err).__name__}); "
-                "the server's log has the details\n", 500, _TEXT)  # fmt: skip
+        return (
+            f"rotomorph serve: internal error ({type(err).__name__}); "
+            "the server's log has the details\n",
+            500,
+            _TEXT,
+        )
+
+
+def _malformed(err: BaseException) -> bool:
+    """Whether ``err`` comes of a request that does not fit the page rather than of a defect:
+    Dash refused it (an unknown callback, component or file), or a lookup or type error raised
+    in Dash's request handling or in this package's callbacks on the values it carried."""
+    from dash.exceptions import DashException
+
+    if isinstance(err, DashException):
+        return True
+    if not isinstance(err, KeyError | IndexError | TypeError):
+        return False
+    tb = err.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    where = Path(tb.tb_frame.f_code.co_filename).as_posix() if tb is not None else ""
+    return "/dash/" in where or "/rotomorph/app/" in where
 
 
 def _cure(text: Any) -> float:
@@ -567,7 +629,9 @@ def _cure(text: Any) -> float:
     value = editing.parse_value(text)
     if value is None:
         return 0.0
-    if not isinstance(value, int | float) or not (0 <= value <= MAX_LAYER_CURE_S and math.isfinite(value)):
+    if not isinstance(value, int | float) or not (
+        0 <= value <= MAX_LAYER_CURE_S and math.isfinite(value)
+    ):
         raise InvalidParameterError(
             "--cure", f"must be a UV dwell per layer in [0, {MAX_LAYER_CURE_S:g}] s; got {text!r}"
         )
@@ -593,7 +657,8 @@ def _status(job: Job, steps: list[dict[str, Any]], units: int) -> str:
         return f"running: {job.phase}"  # every step reached: describing and writing the run
     unit = f"filament {last['unit'] + 1}/{units}, " if units > 1 else ""
     ramp = "°C" if last["ramp"] == "temperature" else "(ramp x)"
-    return f"running: {unit}step {last['step']}/{last['steps']} converged at {last['value']:.4g} {ramp}"
+    step = f"step {last['step']}/{last['steps']}"
+    return f"running: {unit}{step} converged at {last['value']:.4g} {ramp}"
 
 
 def _verdict_rows(rows: list[tuple[str, str, str]]) -> list[Any]:

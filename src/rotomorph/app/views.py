@@ -55,10 +55,14 @@ def lattice_plan(design: Any, modes: list[str], selected: int | None) -> Any:
                 ys += [*pts[:, 1].tolist(), None]
         traces.append(
             go.Scatter(
-                x=xs, y=ys, mode="lines", line={"color": colour, "width": 3}, name=mode,
+                x=xs,
+                y=ys,
+                mode="lines",
+                line={"color": colour, "width": 3},
+                name=mode,
                 hoverinfo="skip",
             )
-        )  # fmt: skip
+        )
     mids = np.array([nodes[np.asarray(c)][len(c) // 2] for c in lattice.edge_chains])
     colours = [EXPANDING_COLOUR if m == "expanding" else CONTRACTING_COLOUR for m in modes]
     sizes = [20 if j == selected else 11 for j in range(len(modes))]
@@ -69,7 +73,10 @@ def lattice_plan(design: Any, modes: list[str], selected: int | None) -> Any:
             mode="markers",
             marker={"color": colours, "size": sizes, "line": {"color": "black", "width": 1.5}},
             customdata=list(range(len(modes))),
-            text=[f"edge {j}: {m}, {float(v):g} mm/s" for j, (m, v) in enumerate(zip(modes, speeds))],
+            text=[
+                f"edge {j}: {m}, {float(v):g} mm/s"
+                for j, (m, v) in enumerate(zip(modes, speeds, strict=True))
+            ],
             hovertemplate="%{text}<extra></extra>",
             name="edges (click to edit)",
         )
@@ -81,8 +88,12 @@ def lattice_plan(design: Any, modes: list[str], selected: int | None) -> Any:
         xaxis={"title": "x (mm)", "scaleanchor": "y"},
         yaxis={"title": "y (mm)"},
         legend={"orientation": "h", "y": 1.0, "yanchor": "bottom"},
-        title={"text": "printed lattice (plan): click an edge's dot to edit it",
-               "font": {"size": 13}, "y": 0.98, "yanchor": "top"},  # fmt: skip
+        title={
+            "text": "printed lattice (plan): click an edge's dot to edit it",
+            "font": {"size": 13},
+            "y": 0.98,
+            "yanchor": "top",
+        },
         clickmode="event",
     )
     return fig

@@ -31,6 +31,7 @@ The worker writes only into the folder the server gave it (a temporary folder of
 
 from __future__ import annotations
 
+import itertools
 import logging
 import traceback
 from pathlib import Path
@@ -98,21 +99,28 @@ def _topology(design: Any) -> dict[str, Any]:
     sizes = [len(p.points) for p in programs]
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
     edges = np.concatenate(
-        [np.stack([np.arange(n - 1), np.arange(1, n)], axis=1) + o for n, o in zip(sizes, starts)]
+        [
+            np.stack([np.arange(n - 1), np.arange(1, n)], axis=1) + o
+            for n, o in zip(sizes, starts[:-1], strict=True)
+        ]
     )
     return {
         "kind": "topology",
         "edges": edges.astype(np.int64),
-        "radius": np.concatenate([np.full(n - 1, p.radius) for n, p in zip(sizes, programs)]),
+        "radius": np.concatenate(
+            [np.full(n - 1, p.radius) for n, p in zip(sizes, programs, strict=True)]
+        ),
         "active_fraction": np.concatenate(
-            [np.full(n - 1, p.active_fraction) for n, p in zip(sizes, programs)]
+            [np.full(n - 1, p.active_fraction) for n, p in zip(sizes, programs, strict=True)]
         ),
         "printed": np.concatenate([np.asarray(p.points, dtype=float) for p in programs]),
         "chains": [
             {"name": f.name or f"filament {i}", "start": int(a), "stop": int(b)}
-            for i, (f, a, b) in enumerate(zip(design.filaments, starts[:-1], starts[1:]))
+            for i, (f, a, b) in enumerate(
+                zip(design.filaments, starts[:-1], starts[1:], strict=True)
+            )
         ],
-        "units": [[int(a), int(b)] for a, b in zip(starts[:-1], starts[1:])],
+        "units": [[int(a), int(b)] for a, b in itertools.pairwise(starts)],
         "contact": design.contact is not None,
         "design_name": design.name,
     }

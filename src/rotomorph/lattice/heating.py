@@ -547,9 +547,9 @@ def heat_lattice(
         announced on the ``rotomorph.progress`` logger ("ramp step 3 of 8 at 131.2 °C").
     on_step
         ``on_step(k, parameter, state, result)`` as each step of the first ramp is reached,
-        the printed state first (``k = 0``, row 0 of the result; ``result`` None): to show converged states
-        while the ramp runs. With ``path_check > 1`` the kept end state may come from the
-        second ramp, which is not reported step by step.
+        the printed state first (``k = 0``, row 0 of the result; ``result`` None): to show
+        converged states while the ramp runs. With ``path_check > 1`` the kept end state may
+        come from the second ramp, which is not reported step by step.
 
     Returns
     -------

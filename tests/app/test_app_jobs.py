@@ -1,0 +1,115 @@
+"""Background jobs: a session's worker process streams each converged step and writes the run
+with the CLI's own functions; one job per session and a cap over all sessions; cancel ends the
+job at once and the session gets a fresh worker."""
+
+from __future__ import annotations
+
+import time
+import uuid
+
+import numpy as np
+import pytest
+import tomli_w
+
+from rotomorph.app.jobs import BusyError, Job, Sessions
+from rotomorph.cli import main
+from rotomorph.io.results import read_results
+
+DESIGN = {
+    "schema_version": 1,
+    "name": "two lines",
+    "filaments": [
+        {
+            "rotation_number": 0.25,
+            "spacing": 1.0,
+            "start": [10.0, 10.0 + 5.0 * i, 0.0],
+            "segments": [{"kind": "line", "length": 8.0}],
+        }
+        for i in range(2)
+    ],
+}
+SLOW = {  # a long lattice ramp: still running when it is cancelled
+    "schema_version": 1,
+    "lattice": {"n": 5, "spacing": 5.0, "amplitude": 1.25, "pattern": "dome", "ghost_nodes": 10},
+}
+
+
+def _wait(sessions: Sessions, sid: str, until, timeout: float = 180.0) -> Job:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        job = sessions.job(sid)
+        if job is not None and until(job):
+            return job
+        time.sleep(0.1)
+    raise AssertionError(f"timed out: {sessions.job(sid)}")
+
+
+@pytest.fixture(scope="module")
+def sessions():
+    s = Sessions(max_jobs=1)
+    yield s
+    s.close()
+
+
+def test_a_run_streams_every_step_and_writes_the_clis_files(sessions, tmp_path):
+    sid = uuid.uuid4().hex
+    sessions.submit(
+        sid, Job("simulate", steps=2), {"kind": "simulate", "design": DESIGN, "steps": 2}
+    )
+    with pytest.raises(BusyError, match="a job is running in this session"):
+        sessions.submit(
+            sid, Job("simulate", steps=2), {"kind": "simulate", "design": DESIGN, "steps": 2}
+        )
+    with pytest.raises(BusyError, match=r"1 job\(s\) are running"):
+        sessions.submit(
+            uuid.uuid4().hex,
+            Job("simulate", steps=2),
+            {"kind": "simulate", "design": DESIGN, "steps": 2},
+        )
+    job = _wait(sessions, sid, lambda j: not j.running)
+    assert job.state == "done", job.error
+    steps = job.step_events()
+    assert [(e["unit"], e["step"]) for e in steps] == [(u, k) for u in (0, 1) for k in range(3)]
+    assert job.topology is not None and len(job.topology["units"]) == 2
+    assert job.first_step_s is not None and job.first_step_s > 0
+    # the same run from the command line: the same states
+    design = tmp_path / "d.toml"
+    design.write_text(tomli_w.dumps(DESIGN), encoding="utf-8")
+    assert (
+        main(["simulate", str(design), "-o", str(tmp_path / "cli"), "--steps", "2", "--no-movie"])
+        == 0
+    )
+    ours = read_results(f"{job.result['folder']}/results.h5")
+    cli = read_results(tmp_path / "cli" / "results.h5")
+    np.testing.assert_allclose(ours.positions, cli.positions, rtol=0, atol=1e-12)
+    assert sorted(p.name for p in (tmp_path / "cli").iterdir()) == sorted(
+        p.name for p in __import__("pathlib").Path(job.result["folder"]).iterdir()
+    )
+    streamed = [e["positions"] for e in steps if e["unit"] == 1]
+    np.testing.assert_allclose(streamed[-1], ours.positions[-1][-len(streamed[-1]) :], atol=1e-5)
+
+
+def test_cancel_ends_a_running_job_and_the_next_one_runs(sessions):
+    sid = uuid.uuid4().hex
+    sessions.submit(
+        sid, Job("simulate", steps=60), {"kind": "simulate", "design": SLOW, "steps": 60}
+    )
+    job = _wait(sessions, sid, lambda j: len(j.step_events()) >= 2 or not j.running)
+    assert job.running, job.error
+    started = time.monotonic()
+    sessions.cancel(sid)
+    assert time.monotonic() - started < 6.0
+    assert job.state == "cancelled" and not job.running
+    sessions.submit(
+        sid, Job("simulate", steps=1), {"kind": "simulate", "design": DESIGN, "steps": 1}
+    )
+    assert _wait(sessions, sid, lambda j: not j.running).state == "done"
+
+
+def test_a_failed_job_reports_the_clis_line(sessions):
+    sid = uuid.uuid4().hex
+    bad = {**DESIGN, "filaments": [{**DESIGN["filaments"][0], "speed": -1.0}]}
+    sessions.submit(sid, Job("simulate", steps=1), {"kind": "simulate", "design": bad, "steps": 1})
+    job = _wait(sessions, sid, lambda j: not j.running)
+    assert job.state == "failed"
+    assert job.error.startswith("filaments[0].speed: must be >= ")
