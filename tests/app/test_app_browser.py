@@ -20,9 +20,11 @@ import tomli_w
 
 from rotomorph.cli import main
 
+pytest.importorskip("dash")
+from rotomorph.app.server import FINAL_CAPTION
+
 pytestmark = pytest.mark.referee
 playwright_api = pytest.importorskip("playwright.sync_api")
-pytest.importorskip("dash")
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs" / "images"
@@ -148,18 +150,18 @@ def test_dome_edit_simulate_and_print(page, server, tmp_path):
         re.search(r": (physical|unstable|not converged|not admissible|unverified)( —|$)", v)
         for v in verdicts
     )
+    playwright_api.expect(pg.locator("#run-shown")).to_have_text(FINAL_CAPTION)  # its file
+    pg.wait_for_selector("#run-view .slider-rail-rect")
     title = pg.locator("#run-view .gtitle").text_content() or ""
     assert "(step 4/4)" in title
-    rail = pg.locator("#run-view .slider-rail-rect").bounding_box()
-    assert rail is not None
-    pg.mouse.click(rail["x"] + 2, rail["y"] + rail["height"] / 2)  # the slider to step 0
-    pg.wait_for_function(
-        "document.querySelector('#run-view .gtitle').textContent.includes('(step 0/4)')"
-    )
-    pg.mouse.click(rail["x"] + rail["width"] * 0.5, rail["y"] + rail["height"] / 2)
-    pg.wait_for_function(
-        "document.querySelector('#run-view .gtitle').textContent.includes('(step 2/4)')"
-    )
+    pg.locator("#run-view .slider-rail-rect").scroll_into_view_if_needed()
+    for where, step in ((0.0, 0), (0.5, 2)):  # the slider to step 0, then to the middle
+        rail = pg.locator("#run-view .slider-rail-rect").bounding_box()
+        assert rail is not None
+        pg.mouse.click(rail["x"] + 2 + where * rail["width"], rail["y"] + rail["height"] / 2)
+        pg.wait_for_function(
+            f"document.querySelector('#run-view .gtitle').textContent.includes('(step {step}/4)')"
+        )
     if SHOT:
         pg.locator("#simulate-panel").screenshot(path=str(DOCS / "app-simulate.png"))
 
@@ -283,3 +285,22 @@ def test_markup_in_every_text_field_is_inert(page):
     assert pg.evaluate("window.__owned") is None
     for selector in ("img[src=x]", "a[href*=evil]", "#run-view b", "#run-view a"):
         assert pg.locator(selector).count() == 0, selector
+
+
+def test_inverse_design_from_the_page_opens_as_the_design(page):
+    pg = page
+    pg.click("#inverse")  # the helix target the panel starts with
+    pg.wait_for_function(
+        "document.querySelector('#inverse-status').innerText.match(/^(done|failed)/)",
+        timeout=240_000,
+    )
+    status = pg.inner_text("#inverse-status")
+    assert status.startswith("done: ") and "RMS error" in status, status
+    pg.click("#inverse-open")
+    pg.wait_for_function("document.querySelector('#prediction').innerText.includes(\"'helix'\")")
+    assert "helix" in _prediction(pg)
+    assert pg.locator('[id*="filaments[0].segments[0].speed"][id*="field"]').count() == 1
+    pg.fill("#target-text", "kind = <b>")  # a broken target: the CLI's own refusal, as text
+    pg.click("#inverse")
+    playwright_api.expect(pg.locator("#inverse-status")).to_contain_text("not started: ")
+    assert pg.locator("#inverse-status b").count() == 0

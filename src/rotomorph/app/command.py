@@ -80,7 +80,7 @@ def command(args: argparse.Namespace) -> int:
         ) from None
     server = make_server(args.host, args.port, app.server, threaded=True, fd=listener.fileno())
     shown = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(args.host, args.host)
-    url = f"http://{f'[{shown}]' if ':' in shown else shown}:{server.server_port}/"
+    url = f"http://{f'[{shown}]' if ':' in shown else shown}:{listener.getsockname()[1]}/"
     logging.getLogger("werkzeug").setLevel(logging.WARNING)
     sys.stderr.write(f"rotomorph: serving the designer at {url} (Ctrl-C stops it)\n")
     sys.stderr.flush()

@@ -99,10 +99,8 @@ class Worker:
         """Start ``job`` (the worker must be idle)."""
         if not self.alive:
             self.start()
-        if job.kind == "simulate":
-            self._runs += 1
-            run = self.folder / f"run{self._runs}"
-            payload = {**payload, "folder": str(run)}
+        self._runs += 1  # each job writes into a folder of its own
+        payload = {**payload, "folder": str(self.folder / f"{job.kind}{self._runs}")}
         self.job = job
         self._inbox.put(payload)
 

@@ -14,7 +14,7 @@ from dash import dcc, html
 
 from rotomorph.app.editing import get_field
 
-__all__ = ["TARGETS", "page", "render_form"]
+__all__ = ["NEW_SEGMENTS", "TARGETS", "page", "render_form"]
 
 _FILAMENT_FIELDS = (
     ("name", "name"),
@@ -36,7 +36,18 @@ _SEGMENT_FIELDS = {
     ),
     "polyline": (),
 }
-_SEGMENT_CONTROLS = (("speed", "speed (mm/s)"), ("rotation_number", "ω*"))
+_SEGMENT_CONTROLS = (
+    ("speed", "speed (mm/s)"),
+    ("rotation_number", "ω*"),
+    ("rotation", "ω (rad/s)"),
+    ("interface_angle_deg", "α (deg)"),
+)
+#: Segments the form appends (a starting shape each; every value editable after).
+NEW_SEGMENTS = {
+    "line": {"kind": "line", "length": 10.0},
+    "arc": {"kind": "arc", "radius": 5.0, "angle_deg": 90.0},
+    "sinusoid": {"kind": "sinusoid", "amplitude": 1.0, "wavelength": 5.0, "periods": 2},
+}
 _LATTICE_FIELDS = (
     ("n", "n (nodes per side)"),
     ("spacing", "spacing l (mm)"),
@@ -193,8 +204,13 @@ def _filament(data: dict[str, Any], i: int, fil: dict[str, Any]) -> Any:
             html.Div([_segment(data, i, j, s) for j, s in enumerate(fil.get("segments", []))]),
             html.Div(
                 [
-                    html.Button(
-                        "+ line segment", id={"type": "seg-add", "fil": i}, className="small"
+                    *(
+                        html.Button(
+                            f"+ {kind}",
+                            id={"type": "seg-add", "fil": i, "kind": kind},
+                            className="small",
+                        )
+                        for kind in NEW_SEGMENTS
                     ),
                     html.Button(
                         "− last segment", id={"type": "seg-remove", "fil": i}, className="small"
@@ -312,7 +328,8 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
                                         [
                                             html.Label("edge speed (mm/s)"),
                                             dcc.Input(id="edge-speed", type="text", debounce=True),
-                                        ]
+                                        ],
+                                        className="edge-speed",
                                     ),
                                     html.Div(
                                         id={"type": "error", "path": "lattice.edge_speeds"},
@@ -353,6 +370,7 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
                                         ),
                                         config={"displaylogo": False},
                                     ),
+                                    html.Div(id="run-shown", className="caption"),
                                     html.Div(id="verdicts", className="verdicts"),
                                     html.Div(
                                         [

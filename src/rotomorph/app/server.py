@@ -21,7 +21,7 @@ from dash import ALL, Dash, Input, Output, State, ctx, dcc, html, no_update
 
 from rotomorph.app import editing, files, views
 from rotomorph.app.jobs import BusyError, Job, Sessions
-from rotomorph.app.layout import TARGETS, page, render_form
+from rotomorph.app.layout import NEW_SEGMENTS, TARGETS, page, render_form
 from rotomorph.errors import InvalidParameterError, MachineLimitError, RotomorphError
 from rotomorph.io.tomlfile import MAX_TOML_BYTES
 
@@ -47,6 +47,10 @@ function(contents, name) {
 }
 """.replace("LIMIT", str(MAX_TOML_BYTES))
 
+
+#: What the run view shows, said under it.
+FINAL_CAPTION = "the finished run, read back from its results.h5 (as rotomorph view shows it)"
+STREAM_CAPTION = "the steps converged so far, as they arrive"
 
 #: Names of this computer's loopback interface (the default ``--host 127.0.0.1``).
 LOCAL_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
@@ -196,7 +200,7 @@ def create_app(
     @app.callback(
         Output("design-data", "data", allow_duplicate=True),
         Output("form", "children", allow_duplicate=True),
-        Input({"type": "seg-add", "fil": ALL}, "n_clicks"),
+        Input({"type": "seg-add", "fil": ALL, "kind": ALL}, "n_clicks"),
         Input({"type": "seg-remove", "fil": ALL}, "n_clicks"),
         State("design-data", "data"),
         prevent_initial_call=True,
@@ -209,7 +213,7 @@ def create_app(
         fil = data["filaments"][i]
         segs = list(fil.get("segments", []))
         if trigger["type"] == "seg-add":
-            segs.append({"kind": "line", "length": 10.0})
+            segs.append(dict(NEW_SEGMENTS[str(trigger["kind"])]))
         elif len(segs) > 1:
             segs.pop()
         new = editing.set_field(data, f"filaments[{i}].segments", segs)
@@ -338,14 +342,11 @@ def create_app(
     )
     def inverse(_n: Any, text: Any, sid: str) -> Any:
         from rotomorph.inverse.targets import parse_target_bytes
-        from rotomorph.io.tomlfile import decode_toml_bytes
 
         raw = str(text or "").encode("utf-8")
         try:
             parse_target_bytes(raw, "target")  # refused as `rotomorph inverse` refuses a file
-            sessions.submit(
-                sid, Job("inverse"), {"kind": "inverse", "target": decode_toml_bytes(raw, "target")}
-            )
+            sessions.submit(sid, Job("inverse"), {"kind": "inverse", "target": raw})
         except (RotomorphError, BusyError) as err:
             return f"not started: {_message(err)}", no_update
         return "designing…", False
@@ -391,9 +392,12 @@ def create_app(
             return [*keep[:6], True, *keep[7:]]
         if job.kind == "inverse":
             done = not job.running
-            status = (
-                job.phase if job.running else job.state + (f": {job.error}" if job.error else "")
-            )
+            if job.running:
+                status = job.phase
+            elif job.state == "done" and job.result:
+                status = f"done: {job.result['line']}"
+            else:
+                status = job.state + (f": {job.error}" if job.error else "")
             design = job.result["design"] if job.state == "done" and job.result else no_update
             return (*keep[:6], done, status, design, job.state != "done")
         steps = job.step_events()
@@ -428,19 +432,21 @@ def create_app(
 
     @app.callback(
         Output("run-view", "figure"),
+        Output("run-shown", "children"),
         Input("generation", "data"),
         State("sid", "data"),
         prevent_initial_call=True,
     )
     def draw(_generation: Any, sid: str) -> Any:
-        # apart from `poll`, so that a slow drawing never holds back the progress shown
+        # apart from `poll`, so that a slow drawing never holds back the progress shown;
+        # the caption says which figure is shown: the steps streamed so far, or the run's file
         job = sessions.job(sid)
         if job is None or job.kind != "simulate":
-            return no_update
+            return no_update, no_update
         if job.state == "done" and job.result:
-            return views.final_figure(job.result["folder"])[0]
+            return views.final_figure(job.result["folder"])[0], FINAL_CAPTION
         figure = views.stream_figure(job)
-        return figure if figure is not None else no_update
+        return (no_update, no_update) if figure is None else (figure, STREAM_CAPTION)
 
     # ------------------------------------------------------------------ files
     @app.callback(

@@ -20,8 +20,9 @@ of numbers, strings and numpy arrays) on its outbox:
     An inverse-design iteration and its objective.
 ``done``
     The job ended: a simulation's run folder (written by the CLI's own
-    :func:`~rotomorph.simulate.outputs.write_run_results`), or an inverse design's design data
-    and summary.
+    :func:`~rotomorph.simulate.outputs.write_run_results`), or an inverse design's: the design
+    file :func:`~rotomorph.inverse.run.inverse_file` wrote (``rotomorph inverse``), read back as
+    data, and its one-line summary.
 ``error``
     The job failed: the one-line message the CLI would print (``field: what and the fix``) and
     whether it was bad input or a failed computation.
@@ -181,22 +182,22 @@ def _simulate(job: dict[str, Any], outbox: Any) -> None:
 
 
 def _inverse(job: dict[str, Any], outbox: Any) -> None:
-    from rotomorph.inverse.run import run_inverse
-    from rotomorph.inverse.targets import parse_target
+    """``rotomorph inverse TARGET -o DESIGN`` on the target text, in the job's folder."""
+    from rotomorph.inverse.run import inverse_file
+    from rotomorph.io.tomlfile import decode_toml_bytes
 
-    target = parse_target(job["target"])
+    folder = Path(job["folder"])
+    folder.mkdir(parents=True)
+    target = folder / "target.toml"
+    target.write_bytes(job["target"])
 
     def progress(iteration: int, value: float) -> None:
         outbox.put({"kind": "iteration", "iteration": int(iteration), "objective": float(value)})
 
-    run = run_inverse(target, progress)
-    outbox.put(
-        {
-            "kind": "done",
-            "design": run.design.model_dump(mode="json", exclude_none=True),
-            "summary": run.summary,
-        }
-    )
+    design = folder / "design.toml"
+    line = inverse_file(target, design, progress)  # "wrote DESIGN and FOLDER/: summary"
+    data = decode_toml_bytes(design.read_bytes(), design.name)
+    outbox.put({"kind": "done", "design": data, "line": line.partition("/: ")[2] or line})
 
 
 def _error(err: BaseException) -> dict[str, Any]:
