@@ -85,6 +85,17 @@ def test_a_run_streams_every_step_and_writes_the_clis_files(sessions, tmp_path):
     assert sorted(p.name for p in (tmp_path / "cli").iterdir()) == sorted(
         p.name for p in __import__("pathlib").Path(job.result["folder"]).iterdir()
     )
+    # what the page draws while a run goes on: the run viewer's figure of the steps so far
+    from rotomorph.app import views
+
+    partial = views.partial_results(job)
+    assert partial.positions.shape == (6, *ours.positions.shape[1:])
+    np.testing.assert_allclose(partial.positions[-1], ours.positions[-1], atol=1e-5)
+    first = steps[2]["positions"]  # filament 0 at its last step, in frame 2
+    np.testing.assert_allclose(partial.positions[2][: len(first)], first, atol=0)
+    figure = views.stream_figure(job)
+    assert figure is not None and len(figure.frames) == 6
+    assert "(step 5/5)" in figure.layout.title.text
     streamed = [e["positions"] for e in steps if e["unit"] == 1]
     np.testing.assert_allclose(streamed[-1], ours.positions[-1][-len(streamed[-1]) :], atol=1e-5)
 

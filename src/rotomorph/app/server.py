@@ -310,6 +310,8 @@ def create_app(
     @app.callback(
         Output("job-status", "children"),
         Output("poll", "disabled"),
+        Output("progress", "value", allow_duplicate=True),
+        Output("verdicts", "children", allow_duplicate=True),
         Input("simulate", "n_clicks"),
         State("design-data", "data"),
         State("steps", "value"),
@@ -329,8 +331,8 @@ def create_app(
                 {"kind": "simulate", "design": data, "steps": int(count)},
             )
         except (RotomorphError, BusyError) as err:
-            return f"not started: {_message(err)}", no_update
-        return "starting…", False
+            return f"not started: {_message(err)}", no_update, no_update, no_update
+        return "starting…", False, "0", []  # the last run's progress and verdicts cleared
 
     @app.callback(
         Output("inverse-status", "children"),
