@@ -871,7 +871,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_calibrate)
     from rotomorph.app import command as serve
 
-    p = sub.add_parser("serve", help="the designer in the browser", description=serve.__doc__)
+    p = sub.add_parser("serve", help="the designer in the browser", description=serve.DESCRIPTION)
     serve.add_arguments(p)
     p.set_defaults(func=serve.command)
     return parser

@@ -14,7 +14,16 @@ from pathlib import Path
 
 from rotomorph.errors import InvalidParameterError
 
-__all__ = ["add_arguments", "command", "default_examples"]
+__all__ = ["DESCRIPTION", "add_arguments", "command", "default_examples"]
+
+#: ``rotomorph serve --help``'s description.
+DESCRIPTION = (
+    "The designer in the browser: a local web application to edit a design, see its "
+    "prediction, simulate it, preview and download its G-code, and design inversely. Listens "
+    "on 127.0.0.1 unless --host says otherwise (there is no login: serve another address only "
+    "on a network you trust); opens the browser unless --no-open; Ctrl-C stops it. Needs "
+    'pip install "rotomorph[app]".'
+)
 
 
 def default_examples() -> Path | None:
