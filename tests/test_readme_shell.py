@@ -28,6 +28,7 @@ and the tutorial notebook, so the tutorial cannot rot either.
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import re
 import shlex
@@ -461,10 +462,15 @@ def test_every_runnable_block_has_its_promises_or_none():
 def test_the_shared_report_units_name_real_tests():
     """``tests/conftest.py`` keeps the README's full ``rotomorph paper`` and the README table
     test on one xdist worker by node id: both ids must exist (a rename would part them)."""
-    from conftest import SHARED_WORK
+    path = ROOT / "tests" / "conftest.py"
+    spec = importlib.util.spec_from_file_location("tests_root_conftest", path)
+    assert spec is not None and spec.loader is not None
+    root_conftest = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(root_conftest)  # by path: ``conftest`` may name another folder's
+    shared_work = root_conftest.SHARED_WORK
 
     ids = {p.id for p in _block_params()}
-    for nodeid in SHARED_WORK:
+    for nodeid in shared_work:
         path, name = nodeid.split("::", 1)
         function, _, param = name.partition("[")
         assert f"def {function}(" in (ROOT / path).read_text(encoding="utf-8"), nodeid
