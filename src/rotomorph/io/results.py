@@ -422,6 +422,9 @@ def summarize(results: RunResults) -> dict[str, Any]:
     }
     if "filaments" in meta:
         out["filaments"] = meta["filaments"]
+    # outside the range the materials law was calibrated on (rotomorph.simulate.extrapolation)
+    out["extrapolated"] = bool(meta.get("extrapolated", False))
+    out["extrapolation"] = list(meta.get("extrapolation") or [])
     return out
 
 

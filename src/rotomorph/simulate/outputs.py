@@ -83,7 +83,9 @@ def _state_title(results: RunResults, k: int, verdicts: list[StepVerdict]) -> tu
     where = "printed" if k == 0 else ("end of heating ramp" if k == last else f"step {k}/{last}")
     v = verdicts[k] if k < last else run_verdict(verdicts)
     colour = _RED if v.verdict == "no" else "k"
-    return f"{where}, {results.step_labels()[k]} — {v.text()}", colour
+    outside = extrapolation_text(results)
+    title = f"{where}, {results.step_labels()[k]} — {v.text()}"
+    return (title + ("\n" + outside if outside else ""), colour)
 
 
 def _chains(results: RunResults) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -274,6 +276,8 @@ def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
             panels.append(type(p)(**{**p.__dict__, "title": label}))
     v = run_verdict(verdicts)
     note = "" if v.verdict == "yes" else f" — {v.text()}"
+    outside = extrapolation_text(results)
+    note += f"\n{outside}" if outside else ""
     return plot_tube_panels(
         panels,
         columns=len(steps),
@@ -310,8 +314,11 @@ def _filament_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
     ax.set_xlabel("temperature (°C)" if "temperature" in results.scalars else "step")
     ax.set_ylabel("L/L0 (–)")
     v = run_verdict(verdicts)
+    outside = extrapolation_text(results)
     ax.set_title(
-        "End-to-end ratio over heating" + ("" if v.verdict == "yes" else f"\n{v.text()}"),
+        "End-to-end ratio over heating"
+        + ("" if v.verdict == "yes" else f"\n{v.text()}")
+        + (f"\n{outside}" if outside else ""),
         fontsize=10,
         color=_RED if v.verdict == "no" else "k",
     )
@@ -355,8 +362,10 @@ def _lattice_metrics_figure(results: RunResults, verdicts: list[StepVerdict]) ->
     right.set_title(f"Characteristic curvature (Gaussian sign at end {sign:+.0f})")
     right.grid(alpha=0.3)
     v = run_verdict(verdicts)
-    if v.verdict != "yes":
-        fig.suptitle(v.text(), color=_RED if v.verdict == "no" else "k", fontsize=10)
+    outside = extrapolation_text(results)
+    lines = ([] if v.verdict == "yes" else [v.text()]) + ([outside] if outside else [])
+    if lines:
+        fig.suptitle("\n".join(lines), color=_RED if v.verdict == "no" else "k", fontsize=10)
     fig.set_layout_engine("constrained")
     return fig
 
@@ -525,10 +534,20 @@ def _segments_to_nodes(values: np.ndarray, edges: np.ndarray, n: int) -> np.ndar
     return out
 
 
+def extrapolation_text(results: RunResults) -> str:
+    """``EXTRAPOLATED: why`` where the run lies outside the calibrated range, else ``""``."""
+    reasons = results.metadata.get("extrapolation") or []
+    return "EXTRAPOLATED: " + "; ".join(str(r) for r in reasons) if reasons else ""
+
+
 def run_line(results: RunResults) -> str:
-    """One line for the command line: per-filament or lattice results and the verdict."""
+    """One line for the command line: per-filament or lattice results, the verdict and, where
+    the settings lie outside the calibrated range, why (``EXTRAPOLATED: ...``)."""
     v = run_verdict(_verdicts(results))
     state = "end state " + v.text()
+    outside = extrapolation_text(results)
+    if outside:
+        state += "; " + outside
     if _kind(results) == "lattice":
         sc = results.scalars
         parts = []

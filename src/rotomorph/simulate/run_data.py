@@ -30,6 +30,7 @@ from rotomorph._typing import FloatArray, IntArray
 from rotomorph.geometry import pair_strains
 from rotomorph.io.results import RunResults, program_record, to_jsonable
 from rotomorph.io.validity import assess, verdict_record
+from rotomorph.simulate.extrapolation import run_extrapolation
 
 __all__ = [
     "active_normals",
@@ -283,6 +284,14 @@ def describe_run(sim: Any) -> RunResults:
     meta.setdefault("contact", False)
     verdicts = assess(all_scalars, meta, s)
     meta["physical"] = verdict_record(verdicts)
+    reasons, per_filament = run_extrapolation(sim)
+    meta["extrapolated"] = bool(reasons)
+    meta["extrapolation"] = reasons
+    if per_filament:
+        per_fil = [
+            {**extra, "extrapolation": why}
+            for extra, why in zip(per_fil or [{}] * len(per_filament), per_filament, strict=False)
+        ]
     if per_fil and "filaments" in meta:
         meta["filaments"] = [
             {**f, **extra} for f, extra in zip(meta["filaments"], per_fil, strict=False)
