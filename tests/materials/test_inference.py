@@ -117,3 +117,42 @@ def test_leave_one_group_out_and_errors() -> None:
         joint_calibrate([], [], TRUE)
     with pytest.raises(InvalidParameterError, match="log parameters"):
         joint_calibrate([], paper_parameters(), TRUE, branch="passive_strain")
+
+
+@dataclasses.dataclass(frozen=True)
+class _Toy:
+    a: float = 0.0
+    b: float = 0.0
+
+
+def test_prior_held_part_of_the_band_is_exact_for_a_linear_gaussian_fit() -> None:
+    """Three measurements of ``a`` (sd 0.5) and none of ``b``: the posterior variance of ``a``
+    splits into the data's and the prior's parts Σ²A and Σ²P (conjugate normal model), and
+    ``b``, unconstrained, is all prior."""
+    from rotomorph.materials.measurements import MeasuredTable
+
+    n, sigma, s_a, s_b = 3, 0.5, 2.0, 0.7
+    table = MeasuredTable(
+        "toy", ("1", "2", "3"), np.zeros(n), ("",) * n, np.array([1.0, 1.2, 0.9]),
+        np.full(n, sigma), ("",) * n, ("",) * n,
+    )  # fmt: skip
+    group = Group("toy", table, lambda m: np.full(n, m.a))
+    fit = joint_calibrate(
+        [group],
+        [
+            Parameter("a", 0.0, s_a, lower=-50, upper=50),
+            Parameter("b", 0.3, s_b, lower=-50, upper=50),
+        ],
+        _Toy(),
+    ).chosen
+    precision_data, precision_prior = n / sigma**2, 1.0 / s_a**2
+    var = 1.0 / (precision_data + precision_prior)
+    _, sd, sd_prior = fit.propagate_parts(lambda m: np.array([m.a, m.b, m.a + m.b]))
+    assert sd[0] == pytest.approx(np.sqrt(var), rel=1e-6)
+    assert sd_prior[0] == pytest.approx(np.sqrt(var**2 * precision_prior), rel=1e-6)
+    assert sd[1] == pytest.approx(s_b, rel=1e-6) and sd_prior[1] == pytest.approx(s_b, rel=1e-6)
+    # a sum: variances add (independent posteriors), and so do the prior parts
+    assert sd_prior[2] ** 2 == pytest.approx(sd_prior[0] ** 2 + sd_prior[1] ** 2, rel=1e-6)
+    # the data's part is what is left, and a measured direction is mostly data
+    assert sd[0] ** 2 - sd_prior[0] ** 2 == pytest.approx(var**2 * precision_data, rel=1e-6)
+    assert sd_prior[0] < 0.2 * sd[0]

@@ -223,18 +223,50 @@ class Fit:
         ``central = False`` uses one-sided secants θ̂ → θ̂ + L e_k (half the evaluations, for
         expensive quantities; first order like the central ones).
         """
+        centre, sd, _ = self.propagate_parts(quantity, central=central)
+        return centre, sd
+
+    def propagate_parts(
+        self, quantity: Predictor, *, central: bool = True
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        r"""Value, propagated sd and the part of that sd the priors hold.
+
+        With the posterior precision H = JᵀJ = A + P (A from the data rows, P = diag(1/s_j²)
+        from the prior rows) and Σ = H⁻¹, the posterior variance of a linear q = gᵀθ splits
+        exactly into gᵀΣAΣg (carried by the data's noise) and gᵀΣPΣg (carried by the priors'
+        width): the MAP estimate is Σ(Aθ_data + Pμ), so its spread comes from the two through
+        those two terms. With the secants s = Lᵀg of :meth:`propagate` (Σ = LLᵀ) the prior
+        part is sᵀ(LᵀPL)s. Where it is most of the variance the data left q open and a
+        comparison within the band holds largely by construction (a weak test).
+
+        Returns
+        -------
+        centre, sd, sd_prior
+            Arrays of ``quantity``'s shape; ``sd_prior ≤ sd``.
+        """
         centre = np.asarray(quantity(self.model), dtype=float)
-        var = np.zeros_like(centre)
-        for d in self.directions().T:
+        dirs = self.directions()
+        secants = []
+        for d in dirs.T:
             if not np.any(d):
+                secants.append(np.zeros_like(centre))
                 continue
             up = np.asarray(quantity(self.model_at(self.theta + d)), dtype=float)
             if central:
                 down = np.asarray(quantity(self.model_at(self.theta - d)), dtype=float)
-                var = var + (0.5 * (up - down)) ** 2
+                secants.append(0.5 * (up - down))
             else:
-                var = var + (up - centre) ** 2
-        return centre, np.sqrt(var)
+                secants.append(up - centre)
+        s = np.asarray(secants).reshape(len(secants), -1)  # (directions, outputs)
+        precision = np.diag([1.0 / p.sd**2 for p in self.parameters])
+        held = dirs.T @ precision @ dirs  # LᵀPL, eigenvalues in [0, 1]
+        var = np.sum(s * s, axis=0)
+        var_prior = np.clip(np.einsum("ki,kl,li->i", s, held, s), 0.0, var)
+        return (
+            centre,
+            np.sqrt(var).reshape(centre.shape),
+            np.sqrt(var_prior).reshape(centre.shape),
+        )
 
     def record(self) -> dict[str, Any]:
         """JSON-able summary (values, ±1 sd intervals, χ², bounds hit)."""
