@@ -3,7 +3,8 @@ r"""Inputs the paper does not give, as stated priors: the nuisance parameters of
 The paper's lattice and sinusoid predictions need numbers it does not report. Each is a
 uniform prior on a stated range, with the argument for the range next to it
 (:data:`NUISANCE_PRIORS`); predictions are made at the priors' centres and the priors are
-propagated into their bands (:mod:`rotomorph.simulate.propagation`). The ranges were set from
+propagated into their bands (:mod:`rotomorph.simulate.nuisance_filaments`,
+:mod:`rotomorph.simulate.nuisance_lattices`). The ranges were set from
 the paper's text alone, before any prediction was computed with them, and are never moved to
 change a score.
 
