@@ -58,6 +58,7 @@ from rotomorph.materials.process import order_parameter
 from rotomorph.rod.model import Model
 from rotomorph.simulate.convergence import at_two_resolutions
 from rotomorph.simulate.free_shape import free_equilibrium, min_clearance
+from rotomorph.simulate.nuisance_filaments import closed_form_band, sinusoid_rows
 
 __all__ = [
     "CONVERGENCE_RTOL",
@@ -258,7 +259,7 @@ def _closed_form_rows(group: str, fit: Fit, full: Fit) -> list[dict[str, Any]]:
         return lambda m: predict(group, table.x, dataclasses.replace(m, resolution=res))
 
     # sensitivities on the fit's mesh (their discretisation error is far below the sd)
-    _, sd = fit.propagate(at(FIT_RESOLUTION))
+    _, sd, sd_prior = fit.propagate_parts(at(FIT_RESOLUTION))
     value = at(lo)(fit.model)
     fine = at(hi)(fit.model)
     in_sample = at(lo)(full.model)
@@ -274,25 +275,28 @@ def _closed_form_rows(group: str, fit: Fit, full: Fit) -> list[dict[str, Any]]:
         else "free helix"
     )
     return [
-        row(
-            quantity,
-            table.condition[i],
-            float(table.value[i]),
-            float(table.spread[i]),
-            float(value[i]),
-            predicted_sd=float(sd[i]),
-            other=float(fine[i]),
-            # P1 section mesh: O(h^2); Richardson error of the coarser value r^p/(r^p - 1) |d|
-            disc_error=4.0 / 3.0 * abs(float(fine[i]) - float(value[i])),
-            resolution=SECTION_RESOLUTIONS,
-            resolution_unit="section boundary vertices",
-            calibrated_without=group,
-            unit=unit,
-            figure=figure,
-            note=f"{how}; model calibrated without this group (fit on "
-            f"{', '.join(g for g in CALIBRATION_GROUPS if g != group)}); in-sample fit: "
-            f"{float(in_sample[i]):.4g}",
-            fitted=_num(float(in_sample[i])),
+        closed_form_band(
+            row(
+                quantity,
+                table.condition[i],
+                float(table.value[i]),
+                float(table.spread[i]),
+                float(value[i]),
+                predicted_sd=float(sd[i]),
+                other=float(fine[i]),
+                # P1 section mesh: O(h^2); Richardson error of the coarser value r^p/(r^p - 1) |d|
+                disc_error=4.0 / 3.0 * abs(float(fine[i]) - float(value[i])),
+                resolution=SECTION_RESOLUTIONS,
+                resolution_unit="section boundary vertices",
+                calibrated_without=group,
+                unit=unit,
+                figure=figure,
+                note=f"{how}; model calibrated without this group (fit on "
+                f"{', '.join(g for g in CALIBRATION_GROUPS if g != group)}); in-sample fit: "
+                f"{float(in_sample[i]):.4g}",
+                fitted=_num(float(in_sample[i])),
+            ),
+            float(sd_prior[i]),
         )
         for i in range(len(table))
     ]
@@ -351,59 +355,49 @@ def _input_rows(full: Fit) -> list[dict[str, Any]]:
 
 
 def _sinusoid_rows(full: Fit) -> list[dict[str, Any]]:
+    """The counted sinusoids at the nuisance priors' centres (with their bands,
+    :func:`rotomorph.simulate.nuisance_filaments.sinusoid_rows`) and the printable design file
+    ``examples/designs/sinusoids.toml`` (:data:`SINUSOID_DESIGN`), shown, not counted."""
     table = load_table("sinusoid_end_to_end")
     lo, hi = FILAMENT_SPACINGS
-    rows = []
     d = SINUSOID_DESIGN
+    flip = d["flip_length"]
     model = at_resolution(full.model)
-    for flip in (IDEAL_FLIP, d["flip_length"]):
-        for i, side in enumerate(("outer", "inner")):
-
-            def ratio(m: FilamentModel, s: str = side, f: float = flip) -> FloatArray:
-                return np.array([sinusoid_ratio(s, at_resolution(m), lo, f)])
-
-            # the printable variant is shown, not counted: no uncertainty propagated for it
-            sd = full.propagate(ratio)[1] if flip == IDEAL_FLIP else np.array([np.nan])
-            res = at_two_resolutions(
-                lambda h, s=side, f=flip: sinusoid_ratio(s, model, h, f),  # type: ignore[misc]
-                lo,
+    rows = sinusoid_rows(full, model)
+    for i, side in enumerate(("outer", "inner")):
+        res = at_two_resolutions(
+            lambda h, s=side: sinusoid_ratio(s, model, h, flip),  # type: ignore[misc]
+            lo,
+        )
+        prog = _program(side, hi, flip)
+        clearance = min_clearance(
+            sinusoid_shape(side, model, hi, flip), exclude_arc=4.0 * float(prog.radius)
+        )
+        touching = clearance < 2.0 * float(prog.radius)
+        rows.append(
+            row(
+                "sinusoid_end_to_end_ratio",
+                table.condition[i] + ", printable 0.5 mm flips",
+                float(table.value[i]),
+                float(table.spread[i]),
+                res.value,
+                counted=False,
+                other=res.coarse,
+                disc_error=res.error,
+                resolution=FILAMENT_SPACINGS,
+                resolution_unit="node spacing (mm)",
+                calibrated_without="sinusoid_end_to_end (never fitted)",
+                unit="1",
+                figure="fig3cd_sinusoids.png",
+                note=f"zero-energy free shape, active {side}, the printable design file "
+                f"examples/designs/sinusoids.toml: pi flips over {flip:g} mm, A = "
+                f"{d['amplitude']:g} mm, wavelength {d['wavelength']:g} mm, {d['periods']:g} "
+                "periods (the package's first assumed geometry, not the priors' centre; not "
+                "counted; converges only as O(h) in the flip zones); self-clearance "
+                f"{clearance:.2f} mm" + ("; SELF-CONTACT (no contact model)" if touching else ""),
+                self_contact=bool(touching),
             )
-            prog = _program(side, hi, flip)
-            clearance = min_clearance(
-                sinusoid_shape(side, model, hi, flip), exclude_arc=4.0 * float(prog.radius)
-            )
-            touching = clearance < 2.0 * float(prog.radius)
-            ideal = flip == IDEAL_FLIP
-            flips = (
-                "ideal step flips of the active side"
-                if ideal
-                else f"printable design file: pi flips over {flip:g} mm (not counted: the "
-                "paper gives no flip length; converges only as O(h) in the flip zones)"
-            )
-            rows.append(
-                row(
-                    "sinusoid_end_to_end_ratio",
-                    table.condition[i] + ("" if ideal else ", printable 0.5 mm flips"),
-                    float(table.value[i]),
-                    float(table.spread[i]),
-                    res.value,
-                    predicted_sd=float(sd[0]) if np.isfinite(sd[0]) else None,
-                    counted=None if ideal else False,
-                    other=res.coarse,
-                    disc_error=res.error,
-                    resolution=FILAMENT_SPACINGS,
-                    resolution_unit="node spacing (mm)",
-                    calibrated_without="sinusoid_end_to_end (never fitted)",
-                    unit="1",
-                    figure="fig3cd_sinusoids.png",
-                    note=f"zero-energy free shape, active {side}, {flips}; A = "
-                    f"{d['amplitude']:g} mm, wavelength {d['wavelength']:g} mm, "
-                    f"{d['periods']:g} periods (geometry assumed, not given in the paper); "
-                    f"self-clearance {clearance:.2f} mm"
-                    + ("; SELF-CONTACT (no contact model)" if touching else ""),
-                    self_contact=bool(touching),
-                )
-            )
+        )
     return rows
 
 
@@ -474,7 +468,36 @@ def summarise(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
                           if r["predicted"] is not None and not r["converged"]],
         "misses_beyond_2": [f"{r['quantity']}: {r['condition']} (z = {r['z']:+.2f})"
                             for r in quantitative if abs(r["z"]) > 2.0],
+        **_discriminating(counted),
     }  # fmt: skip
+
+
+def _discriminating(counted: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The score of the counted rows that are not weak tests
+    (:mod:`rotomorph.simulate.bands`), and the rows that are."""
+    quantitative = [r for r in counted if r["z"] is not None]
+    strong = [r for r in quantitative if r.get("weak_test") is False]
+    within2 = sum(abs(r["z"]) <= 2.0 for r in strong)
+    signs = [r for r in counted if r["z"] is None and r.get("weak_test") is False]
+    return {
+        "discriminating_predictions": len(strong),
+        "discriminating_within_1": sum(abs(r["z"]) <= 1.0 for r in strong),
+        "discriminating_within_2": within2,
+        "fraction_discriminating_within_2": round(within2 / len(strong), 4) if strong else None,
+        "discriminating_signs": len(signs),
+        "discriminating_signs_correct": sum(
+            bool(np.sign(r["predicted"]) == np.sign(r["measured"])) for r in signs
+        ),
+        "weak_tests": [f"{r['quantity']}: {r['condition']}" for r in counted if r.get("weak_test")],
+        "band_not_split": [
+            f"{r['quantity']}: {r['condition']}" for r in counted if r.get("weak_test") is None
+        ],
+        "extrapolated_rows": [
+            f"{r['quantity']}: {r['condition']} ({'; '.join(r.get('extrapolation') or [])})"
+            for r in counted
+            if r.get("extrapolated")
+        ],
+    }
 
 
 def summary_line(summary: dict[str, Any]) -> str:
@@ -492,4 +515,27 @@ def summary_line(summary: dict[str, Any]) -> str:
             if summary.get("informed_rows")
             else ""
         )
+        + _discriminating_line(summary)
     )
+
+
+def _discriminating_line(summary: dict[str, Any]) -> str:
+    if "discriminating_predictions" not in summary:
+        return ""
+    m = summary["discriminating_predictions"]
+    weak = len(summary.get("weak_tests") or [])
+    frac = summary.get("fraction_discriminating_within_2")
+    text = (
+        f". Of them, {weak} are weak tests (bands mostly prior width) and {m} quantitative "
+        f"predictions discriminate: {summary['discriminating_within_1']} within 1 and "
+        f"{summary['discriminating_within_2']} within 2 combined spreads"
+        + ("" if frac is None else f" ({100 * frac:.0f} %)")
+    )
+    if summary.get("discriminating_signs"):
+        text += (
+            f", {summary['discriminating_signs_correct']}/{summary['discriminating_signs']} "
+            "discriminating signs correct"
+        )
+    if summary.get("band_not_split"):
+        text += f"; {len(summary['band_not_split'])} counted row(s) without a split band"
+    return text
