@@ -13,11 +13,15 @@ One line per sample: ``{"case": "sample", "pattern", "sample": {...}, "area_rati
 "gaussian_sign", "cpu_s"}``; then per pattern ``{"case": "pattern", "pattern",
 "sd_nuisance_area", "area_range", "sign_agreement", "samples", "cpu_s"}``; with
 ``--calibration`` also the area's calibration sd and its prior-held part by one-sided secants
-of the same ramp at the priors' centres (``{"case": "calibration", ...}``). ``cpu_s`` is this
+of the same ramp at the priors' centres (``{"case": "calibration", ...}``); with
+``--lift-off`` the dome's and saddle's lift-off and weightless buckling bisected to 0.5 °C at
+the filament-density prior's two ends, the weight's delay as a function of ρ − ρ_bath
+(``{"case": "lift-off", "pattern", "delays": [...]}``). ``cpu_s`` is this
 process's CPU time (the cost on one core, whatever the load). The ramps are cached on disk
 (``ROTOMORPH_CACHE_DIR``), so a second run prints the same numbers at once.
 
-Run: ``python benchmarks/lattice_nuisance.py [--count N] [--calibration] [PATTERN ...]``
+Run: ``python benchmarks/lattice_nuisance.py [--count N] [--calibration] [--lift-off]
+[PATTERN ...]``
 (default 8 samples, all four patterns).
 """
 
@@ -36,6 +40,7 @@ from rotomorph.simulate.nuisance_lattices import (
     LATTICE_SEED,
     area_band,
     heat_sample,
+    lift_off_delays,
     spread,
 )
 from rotomorph.simulate.validation import at_resolution
@@ -50,6 +55,7 @@ def main() -> None:
     )
     parser.add_argument("--count", type=int, default=LATTICE_SAMPLES)
     parser.add_argument("--calibration", action="store_true")
+    parser.add_argument("--lift-off", action="store_true")
     args = parser.parse_args()
     fit = paper_calibration().chosen
     model = at_resolution(fit.model)
@@ -102,6 +108,16 @@ def main() -> None:
                 "pattern": pattern,
                 "sd_calibration_area": cal,
                 "sd_calibration_prior_area": prior,
+                "cpu_s": round(time.process_time() - t0, 2),
+            }
+            print(json.dumps(line), flush=True)
+        if args.lift_off and pattern in ("dome", "saddle"):
+            t0 = time.process_time()
+            delays = lift_off_delays(pattern, N, GHOSTS, STEPS, model, tolerance=0.5)
+            line = {
+                "case": "lift-off",
+                "pattern": pattern,
+                "delays": delays,
                 "cpu_s": round(time.process_time() - t0, 2),
             }
             print(json.dumps(line), flush=True)
