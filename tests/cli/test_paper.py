@@ -24,6 +24,14 @@ KEYS = {
     "calibration",
     "converged",
     "note",
+    # the band in parts, the weak-test verdict and the extrapolation flag
+    "sd_calibration",
+    "sd_nuisance",
+    "sd_numerical",
+    "sd_model_form",
+    "weak_test",
+    "extrapolated",
+    "extrapolation",
 }
 
 
@@ -42,6 +50,13 @@ def test_summary_rows(report):
         assert KEYS <= set(r), r
         if r["measured"] is not None and r["predicted"] is not None:
             assert r["error"] == pytest.approx(r["predicted"] - r["measured"], abs=2e-4)
+        parts = [r[k] for k in ("sd_calibration", "sd_nuisance", "sd_numerical", "sd_model_form")]
+        if r["weak_test"] is not None and r["predicted_sd"] is not None and r["z"] is not None:
+            # the total is the parts' root sum of squares, and z uses it
+            total = float(np.sqrt(sum((p or 0.0) ** 2 for p in parts)))
+            assert r["predicted_sd"] == pytest.approx(total, abs=2e-5)
+            comb = np.hypot(r["spread"], r["predicted_sd"])
+            assert r["z"] == pytest.approx(r["error"] / comb, abs=2e-3)
     quantities = {r["quantity"] for r in rows}
     assert {
         "janus_curvature",

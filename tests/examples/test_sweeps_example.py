@@ -66,7 +66,7 @@ def _readme_rows(quantity: str) -> dict[str, str]:
     out = {}
     for line in text.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 6 and cells[0] == quantity:
+        if len(cells) == 8 and cells[0] == quantity:
             out[cells[1]] = cells[3].split("±")[0].strip()
     return out
 

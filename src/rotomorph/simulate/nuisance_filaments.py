@@ -10,7 +10,10 @@
   sample's T_NI; the nuisance band from a Latin hypercube of :data:`SINUSOID_SAMPLES` samples.
   A finite flip converges only as O(h) in the flip zones, so the rows with flips are computed
   at :data:`FLIP_SPACINGS` and each sample at :data:`SAMPLE_SPACINGS` with Richardson's
-  order-1 extrapolation (its residual error is far below the spread over the priors).
+  order-1 extrapolation (its residual error is far below the spread over the priors); a
+  sample whose free shape passes through itself is solved with self-contact, at
+  :data:`SAMPLE_CONTACT_SPACING` for the calibration secants and the coarser
+  :data:`NUISANCE_CONTACT_SPACING` for the nuisance samples.
 """
 
 from __future__ import annotations
@@ -54,9 +57,13 @@ SAMPLE_SPACINGS = (0.025, 0.0125)
 #: Node spacings (mm) of a counted sinusoid that touches itself (rod solver with self-contact;
 #: about 7 and 19 s of CPU each).
 CONTACT_SPACINGS = (0.025, 0.0125)
-#: Node spacing (mm) of a nuisance or calibration sample that touches itself (its error, about
-#: 1 % of the ratio, is far below the spread over the priors).
+#: Node spacing (mm) of a calibration sample that touches itself (its error, about 1 % of the
+#: ratio, is far below the spread over the priors).
 SAMPLE_CONTACT_SPACING = 0.025
+#: Node spacing (mm) of a nuisance sample that touches itself: coarser, to keep the report's
+#: CPU in bounds (a few per cent of the ratio, still far below the spread over the priors, and
+#: the same for every sample).
+NUISANCE_CONTACT_SPACING = 0.05
 #: Heating steps of a self-contact solve.
 CONTACT_STEPS = 8
 #: Periods of every sinusoid (the end-to-end ratio of a long periodic filament hardly depends
@@ -164,14 +171,16 @@ def heated_shape(side: str, model: FilamentModel, sample: NuisanceSample) -> Flo
     return np.asarray(_shape(side, model, sample, spacings[1]))
 
 
-def _sample_ratio(side: str, model: FilamentModel, sample: NuisanceSample) -> float:
+def _sample_ratio(
+    side: str, model: FilamentModel, sample: NuisanceSample, contact_spacing: float
+) -> float:
     """One sample's ratio: the free shape, order-1 Richardson-extrapolated from
     :data:`SAMPLE_SPACINGS` (step flips: the finer value, already converged); where the free
-    shape passes through itself, the self-contact solve at :data:`SAMPLE_CONTACT_SPACING`."""
+    shape passes through itself, the self-contact solve at ``contact_spacing`` (mm)."""
     h, h2 = SAMPLE_SPACINGS
     radius = float(sinusoid_program(side, sample, h2).radius)
     if self_clearance(side, model, sample, h2) < 2.0 * radius:
-        return contact_ratio(side, model, sample, SAMPLE_CONTACT_SPACING)
+        return contact_ratio(side, model, sample, contact_spacing)
     fine = sinusoid_ratio(side, model, sample, h2)
     if sample.flip_length == 0.0:
         return fine
@@ -223,11 +232,11 @@ def sinusoid_rows(
             )
 
         def ratio(m: FilamentModel, s: str = side) -> FloatArray:
-            return np.array([_sample_ratio(s, at_resolution(m), nominal)])
+            return np.array([_sample_ratio(s, at_resolution(m), nominal, SAMPLE_CONTACT_SPACING)])
 
         # one-sided secants where each evaluation is a contact solve
         _, sd_cal, sd_prior = full.propagate_parts(ratio, central=not touching)
-        values = np.array([_sample_ratio(side, model, s) for s in lhs])
+        values = np.array([_sample_ratio(side, model, s, NUISANCE_CONTACT_SPACING) for s in lhs])
         how = (
             f"its free shape passes through itself (clearance {clearance:.2f} mm < the "
             f"{2 * radius:g} mm diameter), so it is solved with self-contact (rod solver, "
