@@ -96,3 +96,20 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
 
     config.option.loadscopereorder = False  # keep the collection order: slow units first
     return SuiteScheduling(config, log)  # type: ignore[arg-type]
+
+
+@pytest.fixture(scope="session")
+def vtk():
+    """VTK's own Python package (the readers ParaView uses), a referee of our VTK files.
+
+    It is in the ``test`` extra; where it is missing the test is skipped with the install
+    line, and under ``ROTOMORPH_REQUIRE_REFEREES=1`` it fails.
+    """
+    try:
+        import vtk as module  # type: ignore[import-not-found]
+    except ImportError:
+        message = "referee 'vtk' (VTK's own readers) is not installed (pip install -e \".[test]\")"
+        if REQUIRE_REFEREES:
+            pytest.fail(message + "; ROTOMORPH_REQUIRE_REFEREES=1 requires it", pytrace=False)
+        pytest.skip(message)
+    return module

@@ -178,7 +178,9 @@ def test_simulate_filament_writes_everything(tmp_path, capsys):
     assert movie.suffix in (".mp4", ".gif") and movie.stat().st_size > 10_000
     pvd = (out / "paraview" / "morphing.pvd").read_text()
     assert pvd.count("<DataSet") == 4
-    assert len(list((out / "paraview").glob("*.vtp"))) == 4
+    assert len(list((out / "paraview").glob("morphing_*.vtp"))) == 4
+    assert len(list((out / "paraview").glob("janus_*.vtp"))) == 4  # the Janus tube surfaces
+    assert (out / "paraview" / "show_janus.py").is_file()
     assert _leftovers(out.parent) == []
     # refuses to overwrite, then --force replaces
     assert main(["simulate", str(_design(tmp_path)), "-o", str(out), "--steps", "2"]) == EXIT_USAGE

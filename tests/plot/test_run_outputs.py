@@ -136,21 +136,24 @@ def test_titles_never_call_an_unphysical_state_final(run_file, monkeypatch):
 
 def test_vtk_files_open_in_meshio_with_units_in_names(run_file, tmp_path):
     res = read_results(run_file)
-    pvd_vtp, pvd_vtu = write_vtk(res, tmp_path / "paraview")
+    pvd_vtp, pvd_vtu, pvd_janus, script = write_vtk(res, tmp_path / "paraview")
     assert pvd_vtp.name == "morphing.pvd" and pvd_vtu.name == "segments.pvd"
+    assert pvd_janus.name == "janus.pvd" and script.name == "show_janus.py"
     mesh = meshio.read(tmp_path / "paraview" / "segments_0002.vtu")
     np.testing.assert_allclose(mesh.points, res.positions[2])
     lines = mesh.cells_dict["line"]
     np.testing.assert_array_equal(lines, res.edges)
-    np.testing.assert_allclose(mesh.cell_data["active_normal"][0], res.fields["active_normal"][2])
+    np.testing.assert_allclose(
+        mesh.cell_data["active_normal [1]"][0], res.fields["active_normal"][2]
+    )
     np.testing.assert_allclose(mesh.cell_data["radius [mm]"][0], 0.3)
-    assert "curvature [1/mm]" in mesh.point_data and "arc_length [mm]" in mesh.point_data
+    assert "curvature [1/mm]" in mesh.point_data and "s [mm]" in mesh.point_data
     # the .vtp polylines carry per-segment arrays as point data (mean of a node's segments)
     import xml.etree.ElementTree as ET
 
     root = ET.parse(tmp_path / "paraview" / "morphing_0002.vtp").getroot()
     names = {a.get("Name") for a in root.iter("DataArray")}
-    assert {"active_normal", "radius [mm]", "arc_length [mm]", "curvature [1/mm]"} <= names
+    assert {"active_normal [1]", "radius [mm]", "s [mm]", "curvature [1/mm]"} <= names
 
 
 def test_cli_plot_and_view(run_file, tmp_path, capsys):

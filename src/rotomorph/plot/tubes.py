@@ -75,6 +75,15 @@ def interface_offset(active_fraction: float) -> float:
     return 0.5 * (lo + hi)
 
 
+def _dot(a: FloatArray, b: FloatArray) -> FloatArray:
+    return np.einsum("ij,ij->i", a, b)
+
+
+def _dot3(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Dot product over the last axis, broadcasting."""
+    return np.sum(a * b, axis=-1)
+
+
 def _unit(v: FloatArray) -> FloatArray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.where(n > 0, n, 1.0)
@@ -86,15 +95,18 @@ def _any_perpendicular(t: FloatArray) -> FloatArray:
 
 
 def _end_frames(
-    pos: FloatArray, edges: IntArray, t: FloatArray, ref: FloatArray
+    pos: FloatArray, edges: IntArray, t: FloatArray, ref: FloatArray, radius: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Plane normal and reference direction of each segment's two end rings ``(E, 2, 3)``.
 
     At an ordinary node (two segments, no hairpin) both segments' rings lie in the bisector
     plane (a mitre) and, where their reference directions agree (``ref`` within 90°), share
     the mean of the two, so the rings coincide and the tube has no seam; elsewhere each end
-    has its segment's own tangent and reference direction.
+    has its segment's own tangent and reference direction. A turn so sharp that the mitre
+    would fold the tube onto itself (``radius · tan(θ/2)`` beyond half the shorter segment,
+    e.g. a lattice's corner) keeps both segments' own rings as well.
     """
+    lengths = np.linalg.norm(pos[edges[:, 1]] - pos[edges[:, 0]], axis=1)
     n = len(pos)
     incident: list[list[int]] = [[] for _ in range(n)]
     for j, (a, b) in enumerate(edges):
@@ -111,6 +123,9 @@ def _end_frames(
         tf = t[f] if edges[f, 0] == node else -t[f]
         if float(te @ tf) < -0.5:  # a hairpin: a mitre would be degenerate
             continue
+        half_turn = float(np.linalg.norm(np.cross(te, tf))) / (1.0 + float(te @ tf))
+        if max(radius[e], radius[f]) * half_turn > 0.5 * min(lengths[e], lengths[f]):
+            continue  # the mitred rings would cross inside the bend
         mitre = _unit(te + tf)
         shared = _unit(ref[e] + ref[f]) if float(ref[e] @ ref[f]) > 0.0 else None
         for j in inc:
@@ -173,7 +188,7 @@ def tube_mesh(
     ref = _any_perpendicular(t) if normals is None else np.asarray(normals, dtype=float)
     if ref.shape != (m, 3):
         raise InvalidParameterError("normals", f"must have shape ({m}, 3); got {ref.shape}")
-    ends, refs = _end_frames(pos, e, t, ref)
+    ends, refs = _end_frames(pos, e, t, ref, r)
     centres = np.stack([a, b], axis=1)  # (E, 2, 3)
     u = refs - np.einsum("eij,eij->ei", ends, refs)[..., None] * ends
     bad = np.linalg.norm(u, axis=-1) < 1e-9  # normal along the tangent: any perpendicular
@@ -181,30 +196,46 @@ def tube_mesh(
         fallback = np.repeat(_any_perpendicular(t)[:, None, :], 2, axis=1)
         u = np.where(bad[..., None], fallback, u)
     u = _unit(u)
-    v = np.cross(ends, u)
+    # the circle of radius r about the segment's own axis (from the end plane's reference
+    # direction, itself in the end plane), carried along the axis into the end plane: at a
+    # mitre both neighbours' cylinders meet the plane in one ellipse, point for point
+    tt = t[:, None, :]
+    u = _unit(u - _dot3(u, tt)[..., None] * tt)
+    v = np.cross(np.broadcast_to(tt, u.shape), u)
     phi = 2.0 * np.pi * np.arange(k + 1) / k
     c, s = np.cos(phi), np.sin(phi)
-    # rings (E, 2, k+1, 3); each end ring lies in its mitre plane, on the circle of radius r
-    # measured in the segment's perpendicular plane (scaled so neighbours share the circle)
-    rings = centres[:, :, None, :] + r[:, None, None, None] * (
+    around = r[:, None, None, None] * (
         c[None, None, :, None] * u[:, :, None, :] + s[None, None, :, None] * v[:, :, None, :]
-    )
+    )  # (E, 2, k+1, 3)
+    lift = _dot3(around, ends[:, :, None, :]) / _dot3(tt, ends)[:, :, None]
+    rings = centres[:, :, None, :] + around - lift[..., None] * tt[:, :, None, :]
+    # an end ring that shares its angular origin with the neighbour beyond it (a mitre) starts
+    # up to 45° away from this segment's own reference direction: number both rings from the
+    # point nearest to that direction, so facet i lies within half a facet of angle 2π(i+½)/k
+    # from it at both ends (no facet twisted by more than a facet; the Janus sides by index)
+    own = _unit(ref - _dot(ref, t)[:, None] * t)
+    own = np.where((np.linalg.norm(own, axis=1) < 1e-9)[:, None], _any_perpendicular(t), own)
+    for end in (0, 1):
+        off = np.arctan2(_dot(np.cross(own, u[:, end]), t), _dot(own, u[:, end]))
+        shift = np.rint(off * k / (2.0 * np.pi)).astype(np.int64)
+        if shift.any():
+            index = (np.arange(k)[None, :] - shift[:, None]) % k
+            ring = np.take_along_axis(rings[:, end, :k], index[:, :, None], axis=1)
+            rings[:, end] = np.concatenate([ring, ring[:, :1]], axis=1)
     quads = quad_corners(rings)
-    mid_phi = phi[:-1] + np.pi / k
-    um = _unit(ref - np.einsum("ij,ij->i", t, ref)[:, None] * t)
-    um = np.where((np.linalg.norm(um, axis=1) < 1e-9)[:, None], _any_perpendicular(t), um)
-    vm = np.cross(t, um)
-    face_normals = (
-        np.cos(mid_phi)[None, :, None] * um[:, None, :]
-        + np.sin(mid_phi)[None, :, None] * vm[:, None, :]
-    ).reshape(m * k, 3)
     segment = np.repeat(np.arange(m), k)
+    # shading: each facet's outward direction from where it is drawn (its centre seen from the
+    # axis, in the segment's cross-section)
+    ts = t[segment]
+    out = quads.mean(axis=1) - 0.5 * (a + b)[segment]
+    face_normals = _unit(out - np.einsum("ij,ij->i", out, ts)[:, None] * ts)
     active = None
     if normals is not None:
         frac = np.broadcast_to(np.asarray(active_fraction, dtype=float), (m,))
         offsets = {f: interface_offset(f) for f in np.unique(frac)}
         d = np.array([offsets[f] for f in frac])
-        active = np.repeat(np.cos(mid_phi)[None, :], m, axis=0).reshape(-1) > d[segment]
+        mid_phi = 2.0 * np.pi * (np.arange(k) + 0.5) / k
+        active = np.tile(np.cos(mid_phi), m) > d[segment]
     return quads, face_normals, active, segment
 
 

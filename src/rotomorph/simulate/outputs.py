@@ -19,9 +19,9 @@ Folder layout::
                                                 (κ − κ_i)/κ_i on the scale of the physical states
     figures/lattice_metrics.png                 lattices: area, curvature vs strain
     figures/morphing.mp4    the morphing (GIF where no ffmpeg is installed)
-    paraview/morphing.pvd   + morphing_0000.vtp …: polylines with point data per step
-    paraview/segments.pvd   + segments_0000.vtu …: one line cell per segment, per-segment data
-                            (directors, active side, radius); readable by meshio
+    paraview/               ParaView series (:mod:`rotomorph.simulate.paraview`): centre lines,
+                            segments, Janus tube surfaces with an ``active`` flag, one set of
+                            array names with units for every run kind, and ``show_janus.py``
 
 States that are not physical are flagged in every figure title (:mod:`rotomorph.io.validity`).
 """
@@ -37,7 +37,7 @@ import numpy as np
 
 from rotomorph.io.results import RunResults, summarize, write_results, write_summary
 from rotomorph.io.validity import StepVerdict, assess, run_verdict
-from rotomorph.io.vtk import network_lines, write_vtp_series, write_vtu_series
+from rotomorph.simulate.paraview import write_vtk
 
 #: Phase messages of the writing steps (a command line shows them; silent by default).
 phase_log = logging.getLogger("rotomorph.progress")
@@ -452,86 +452,6 @@ def plot_run(
     if movie:
         paths.append(_movie(results, verdicts, out / "morphing.mp4"))
     return paths
-
-
-def write_vtk(results: RunResults, folder: str | os.PathLike[str]) -> list[Path]:
-    """ParaView series of the run into ``folder``: polylines (``morphing.pvd`` + ``.vtp``) with
-    per-node data, and one line cell per segment (``segments.pvd`` + ``.vtu``, meshio-readable)
-    with per-segment data; static arrays are repeated in every step."""
-    target = Path(folder)
-    target.mkdir(parents=True, exist_ok=True)
-    n, e, s = results.positions.shape[1], len(results.edges), results.n_steps
-    point: dict[str, np.ndarray] = {}
-    cell: dict[str, np.ndarray] = {}
-    for name, v in results.fields.items():
-        if v.ndim >= 2 and v.shape[1] == n:
-            point[name] = v
-        if v.ndim >= 2 and v.shape[1] == e:
-            cell[name] = v
-    for name, v in results.static.items():
-        if len(v) == n and name not in point:
-            point[name] = np.broadcast_to(v, (s, *v.shape))
-        if len(v) == e and name not in cell:
-            cell[name] = np.broadcast_to(v, (s, *v.shape))
-    # lattice measures per lattice edge onto its segments (cell data)
-    lattice_edge = results.static.get("lattice_edge")
-    if lattice_edge is not None and len(lattice_edge) == e and lattice_edge.max() >= 0:
-        count, on = int(lattice_edge.max()) + 1, lattice_edge >= 0
-        for name, v in results.fields.items():
-            if v.ndim == 2 and v.shape[1] == count and count not in (n, e):
-                cell[name] = np.where(on[None, :], v[:, np.maximum(lattice_edge, 0)], np.nan)
-    # per-segment arrays also as point data (mean of the incident segments; directions
-    # normalised) so the .vtp polylines, which carry point data only, hold them too
-    for name, v in list(cell.items()):
-        if name not in point and np.asarray(v).dtype.kind == "f":
-            point[name] = _segments_to_nodes(np.asarray(v, dtype=float), results.edges, n)
-
-    def named(arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        # VTK arrays carry no unit attribute: dimensional ones name it, e.g. "twist [1/mm]"
-        out = {}
-        for name, v in arrays.items():
-            unit = results.units.get(name, "1")
-            out[name if unit in ("1", "") else f"{name} [{unit}]"] = v
-        return out
-
-    point, cell = named(point), named(cell)
-    times = results.scalars.get("temperature", results.scalars.get("actuation"))
-    t = None if times is None else list(map(float, times))
-    return [
-        write_vtp_series(
-            target / "morphing.pvd",
-            results.positions,
-            network_lines(results.edges, results.branch),
-            times=t,
-            point_data=point,
-        ),
-        write_vtu_series(
-            target / "segments.pvd",
-            results.positions,
-            results.edges,
-            times=t,
-            point_data=point,
-            cell_data=cell,
-        ),
-    ]
-
-
-def _segments_to_nodes(values: np.ndarray, edges: np.ndarray, n: int) -> np.ndarray:
-    """Mean over each node's segments of per-segment ``(S, E, ...)`` values → ``(S, N, ...)``;
-    3-vectors are renormalised (unit directions stay unit where they do not cancel)."""
-    out = np.zeros((values.shape[0], n, *values.shape[2:]))
-    count = np.zeros(n)
-    clean = np.nan_to_num(values)
-    for end in (0, 1):
-        for k in range(values.shape[0]):
-            np.add.at(out[k], edges[:, end], clean[k])
-        np.add.at(count, edges[:, end], 1.0)
-    shape = (1, n) + (1,) * (values.ndim - 2)
-    out /= np.maximum(count, 1.0).reshape(shape)
-    if values.ndim == 3 and values.shape[2] == 3:
-        norm = np.linalg.norm(out, axis=2, keepdims=True)
-        out = np.where(norm > 1e-9, out / np.where(norm > 0, norm, 1.0), 0.0)
-    return out
 
 
 def extrapolation_text(results: RunResults) -> str:
