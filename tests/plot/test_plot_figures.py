@@ -174,3 +174,34 @@ def test_animate_gif_rejects_bad_input(tmp_path):
     with pytest.raises(InvalidParameterError, match="values"):
         animate_gif(pos[None], edges, tmp_path / "a.gif", values=np.zeros((2, len(pos))))
     assert os.listdir(tmp_path) == []
+
+
+def test_relative_change_scale_is_set_where_the_filament_was_printed_curved():
+    """(κ − κᵢ)/κᵢ blows up near a sinusoid's inflections (κᵢ → 0): those values are clipped
+    (an arrow on the colour bar), not allowed to wash out the rest; each sign gets half the
+    colours (the ratio is never below −1)."""
+    from matplotlib.colors import TwoSlopeNorm
+
+    from rotomorph.plot.shapes import (
+        RELATIVE_CHANGE_LABEL,
+        colourbar_extend,
+        colourbar_ticks,
+        relative_change_norm,
+    )
+
+    rng = np.random.default_rng(1)
+    arcs = rng.uniform(-0.5, 1.5, 400)  # where the print was curved (κᵢ ≈ 1/mm)
+    near_inflection = rng.uniform(5.0, 40.0, 60)  # κᵢ ≈ 0.02/mm
+    values = np.r_[arcs, near_inflection]
+    printed = np.r_[np.full(400, 1.0), np.full(60, 0.02)]
+    norm = relative_change_norm(values, printed)
+    assert isinstance(norm, TwoSlopeNorm) and norm.vcenter == 0.0
+    assert -0.5 <= norm.vmin < -0.4 and 1.4 < norm.vmax <= 1.5  # the arcs' 2nd-98th percentile
+    assert colourbar_extend(norm, values) == "both"
+    ticks = colourbar_ticks(norm)
+    assert ticks is not None and min(ticks) < 0 < max(ticks) and 0.0 in ticks
+    # the figure says what κᵢ is
+    assert "κᵢ: curvature as printed" in RELATIVE_CHANGE_LABEL
+    # a flat printed state (zero up to round-off) stays neutral
+    flat = relative_change_norm(np.full(10, 1e-9), np.ones(10))
+    assert flat.vmin <= -1e-3 and flat.vmax >= 1e-3

@@ -137,3 +137,41 @@ def test_colour_scale_does_not_amplify_round_off():
     assert np.all(np.abs(norm(noise) - 0.5) < 1e-3)
     real = np.linspace(-0.2, 0.3, 50)
     assert scalar_norm(real).vmax == pytest.approx(np.percentile(real, 98))
+
+
+def _content_box(rgb: np.ndarray) -> tuple[int, int, int, int]:
+    """Rows and columns of the pixels that are not white: (top, bottom, left, right)."""
+    ink = np.argwhere(rgb.min(axis=2) < 235)
+    return ink[:, 0].min(), ink[:, 0].max(), ink[:, 1].min(), ink[:, 1].max()
+
+
+def test_panels_are_framed_to_what_they_show():
+    """A long straight filament and a flat lattice fill their figures (before: a 3-D box in a
+    square panel, most of it white)."""
+    s = np.linspace(0.0, 30.0, 61)
+    line = np.c_[s, 0 * s, 0 * s]
+    edges = np.stack([np.arange(60), np.arange(1, 61)], 1)
+    normals = np.tile([0.0, 0.0, 1.0], (60, 1))
+    fig = plot_tube_panels([TubePanel(line, edges, 0.3, normals)], legend=False, dpi=60)
+    rgb = figure_to_rgb(fig)
+    top, bottom, left, right = _content_box(rgb)
+    h, w = rgb.shape[:2]
+    assert (right - left) > 0.85 * w and (bottom - top) > 0.7 * h
+    assert w > 2.0 * h  # a long thin shape gets a wide, low figure
+
+
+def test_a_small_shape_beside_a_long_ghost_gets_an_inset():
+    pts, edges, inward = coil(n=80, turns=3.0, radius=0.8, pitch=0.9)
+    s = np.linspace(0.0, 40.0, len(pts))
+    ghost = np.c_[s - 20.0, 0 * s - 3.0, 0 * s - 1.0]
+    straight = TubePanel(ghost, edges, 0.3, np.tile([0.0, 0.0, 1.0], (len(edges), 1)))
+    small = TubePanel(pts, edges, 0.3, inward, ghost=ghost)
+    fig = plot_tube_panels([small, straight], dpi=60)
+    assert [ax.get_label() for ax in fig.axes if ax.name == "3d"] == ["panel", "inset", "panel"]
+    labels = [t.get_text() for ax in fig.axes if ax.name != "3d" for t in ax.texts]
+    (times,) = [t for t in labels if t.startswith("×")]
+    assert float(times[1:]) >= 2.0
+    # a movie keeps its frame: no insets with a fixed extent
+    centres = [np.zeros(3), np.zeros(3)]
+    fixed = plot_tube_panels([small, straight], extent=(centres, np.full(3, 21.0)), dpi=40)
+    assert len([ax for ax in fixed.axes if ax.name == "3d"]) == 2

@@ -70,12 +70,12 @@ def test_filament_figure_draws_janus_tubes_on_one_scale(model):
             x = free_shape(prog, model)
             shapes[(label, w)] = (prog, x, free_shape_normals(prog, model, x))
     fig = filament_shapes_figure(shapes)
-    axes = [ax for ax in fig.axes if ax.name == "3d"]
+    axes = [ax for ax in fig.axes if ax.get_label() == "panel"]
     assert len(axes) == 4
     # one scale: every panel's box spans the same millimetres
     spans = {tuple(np.round([np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim())], 6)) for ax in axes}
     assert len(spans) == 1
-    titles = [t.get_text() for ax in axes for t in ax.texts if "L/L0" in t.get_text()]
+    titles = [t.get_text() for t in fig.texts if "L/L0" in t.get_text()]
     assert len(titles) == 4 and any("composite, ω* = 0.06" in t for t in titles)
     rgb = figure_to_rgb(fig)
     assert _pixels(rgb, ACTIVE_COLOUR) > 200 and _pixels(rgb, PASSIVE_COLOUR) > 200

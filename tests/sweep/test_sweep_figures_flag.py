@@ -38,3 +38,16 @@ def test_heatmap_crosses_the_unphysical_points():
     crosses = [c for c in ax.collections if c.get_label().startswith("not physical")]
     assert len(crosses) == 1
     assert crosses[0].get_offsets().tolist() == [[1.0, 0.0]]
+
+
+def test_panels_share_one_legend_with_each_entry_once():
+    table = _table().append_column("curvature", pa.array([0.1, 0.2, 0.3, 0.4]))
+    fig = plot_curve(table, "speed", ["end_to_end_ratio", "curvature"], group="rotation")
+    assert all(ax.get_legend() is None for ax in fig.axes)  # no legend repeated per panel
+    (legend,) = fig.legends
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert labels.count("rotation = 0.0") == 1 and labels.count("rotation = 1.0") == 1
+    assert labels.count("not physical (see physical_reason)") == 1
+    # a single curve needs no legend at all
+    one = plot_curve(_table().slice(0, 1), "speed", ["end_to_end_ratio"])
+    assert one.axes[0].get_legend() is None and not one.legends

@@ -10,7 +10,7 @@ seed; the sign of the Gaussian curvature must not (tested on several seeds).
 
 Measurements per step (index 0 = the flat printed state): the normalised projected area of the
 boundary loop (paper Fig. 3G), the quadratic-surface fit of the branch nodes (Gaussian sign and
-characteristic curvature √|k1 k2|, Fig. 4), the mean edge strain and every edge's end-to-end
+characteristic curvature √|k₁k₂|, Fig. 4), the mean edge strain and every edge's end-to-end
 ratio (Fig. 4C/F "strain"), and the smallest distance between non-adjacent
 segments relative to the filament diameter, ignoring pairs already closer than a diameter as
 printed (fused at junctions). Without ``contact`` filaments may pass through each other: values
@@ -223,7 +223,7 @@ class HeatingResult:
     gaussian_sign
         Sign of the fitted Gaussian curvature of the branch nodes (+1 dome, −1 saddle, 0 flat).
     characteristic_curvature
-        √|k1 k2| of that fit (1/mm).
+        √|k₁k₂| of that fit (1/mm).
     mean_edge_strain
         Mean end-to-end strain of the lattice edges (dimensionless).
     edge_ratios

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection
-from matplotlib.colors import Colormap, Normalize
+from matplotlib.colors import Colormap, Normalize, TwoSlopeNorm
 from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
@@ -24,8 +24,12 @@ if TYPE_CHECKING:
     from mpl_toolkits.mplot3d.axes3d import Axes3D
 
 __all__ = [
+    "RELATIVE_CHANGE_LABEL",
+    "colourbar_extend",
+    "colourbar_ticks",
     "plot_lattice_views",
     "plot_network_3d",
+    "relative_change_norm",
     "scalar_colormap",
     "scalar_norm",
     "segment_values",
@@ -33,6 +37,9 @@ __all__ = [
 ]
 
 _GREY = (0.6, 0.6, 0.6, 1.0)
+
+#: Colour-bar label of the relative curvature change, every symbol defined on the figure.
+RELATIVE_CHANGE_LABEL = "(κ − κᵢ)/κᵢ\nκ: curvature, κᵢ: curvature as printed"
 
 
 def _check(positions: object, edges: object) -> tuple[FloatArray, IntArray]:
@@ -99,7 +106,69 @@ def scalar_norm(
     return Normalize(vmin=vmin, vmax=vmax)
 
 
-def _style(collection, values, edges, n_nodes, cmap, vmin, vmax, color):
+def relative_change_norm(
+    values: FloatArray, printed: FloatArray, *, floor: float = 1e-3, share: float = 0.25
+) -> Normalize:
+    """Colour limits for the relative curvature change (κ − κᵢ)/κᵢ (paper Fig. 4).
+
+    The ratio grows without bound where the printed curvature κᵢ vanishes (a sinusoid's
+    inflection points), so the limits are set by the values where the filament was printed
+    clearly curved: κᵢ at least ``share`` times its median. They span the 2nd to 98th
+    percentile of those values, each sign on its own half of the colour map (the ratio is
+    never below −1, while it may reach +5: a symmetric scale would spend half its colours on
+    values that do not occur); the rest is clipped (the colour bar's arrows,
+    :func:`colourbar_extend`).
+
+    Parameters
+    ----------
+    values
+        Relative curvature changes (per segment or per node), NaN where undefined.
+    printed
+        κᵢ (1/mm) at the same places.
+    floor
+        Limits never come closer to 0 than this (a flat printed state is neutral, not noise).
+    share
+        Fraction of the median κᵢ below which a value does not set the limits.
+    """
+    v = np.asarray(values, dtype=float)
+    k = np.asarray(printed, dtype=float)
+    good = np.isfinite(v) & np.isfinite(k)
+    if good.any():
+        good &= k >= share * float(np.median(k[good]))
+    pick = v[good] if good.any() else v[np.isfinite(v)]
+    if len(pick) == 0:
+        return Normalize(-floor, floor)
+    lo, hi = (float(q) for q in np.percentile(pick, [2.0, 98.0]))
+    lo, hi = min(lo, -floor), max(hi, floor)
+    return TwoSlopeNorm(vcenter=0.0, vmin=lo, vmax=hi)
+
+
+def colourbar_ticks(norm: Normalize) -> list[float] | None:
+    """Round ticks on both halves of a two-slope colour bar (matplotlib's own would leave the
+    shorter half bare); ``None`` (matplotlib's choice) for a linear one."""
+    if not isinstance(norm, TwoSlopeNorm) or norm.vmin is None or norm.vmax is None:
+        return None
+    from matplotlib.ticker import MaxNLocator
+
+    locate = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10])
+    low = [t for t in locate.tick_values(norm.vmin, 0.0) if norm.vmin <= t < 0.0]
+    high = [t for t in locate.tick_values(0.0, norm.vmax) if 0.0 < t <= norm.vmax]
+    return [*low, 0.0, *high]
+
+
+def colourbar_extend(norm: Normalize, values: FloatArray) -> str:
+    """``"neither"``, ``"min"``, ``"max"`` or ``"both"``: which ends of a colour bar ``values``
+    pass (clipped values get an arrow)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    low = bool(len(v) and norm.vmin is not None and v.min() < norm.vmin)
+    high = bool(len(v) and norm.vmax is not None and v.max() > norm.vmax)
+    return {(False, False): "neither", (True, False): "min", (False, True): "max"}.get(
+        (low, high), "both"
+    )
+
+
+def _style(collection, values, edges, n_nodes, cmap, vmin, vmax, color, norm=None):
     if values is None:
         collection.set_color(color)
         return None
@@ -109,7 +178,7 @@ def _style(collection, values, edges, n_nodes, cmap, vmin, vmax, color):
     seg = segment_values(v, edges)
     collection.set_array(np.ma.masked_invalid(seg))
     collection.set_cmap(scalar_colormap(cmap))
-    collection.set_norm(scalar_norm(seg, vmin, vmax))
+    collection.set_norm(scalar_norm(seg, vmin, vmax) if norm is None else norm)
     return collection
 
 
@@ -199,27 +268,45 @@ def plot_lattice_views(
     title: str = "",
     linewidth: float = 1.2,
     color: str = "k",
+    norm: Normalize | None = None,
 ) -> Figure:
-    """Top (x–y) and side (x–z) views of a lattice at equal scale (paper Fig. 4A/D).
+    """Top (x–y) and side (x–z) views of a lattice at one scale (paper Fig. 4A/D).
 
-    Parameters are those of :func:`plot_network_3d`.
+    Parameters are those of :func:`plot_network_3d`; ``norm`` (e.g.
+    :func:`relative_change_norm`) replaces ``vmin``/``vmax``.
     """
     pos, e = _check(positions, edges)
-    fig = new_figure(10.0, 4.6)
-    top, side = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.0, 1.4]})
+    # the side view under the top view, both at one scale and sharing x (as a drawing's
+    # projections), each as tall as the lattice is along its axis: no empty bands
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    pad = 0.04 * float((hi - lo)[:2].max() or 1.0)
+    lo, hi = lo - pad, hi + pad
+    span = np.maximum(hi - lo, 0.06 * float((hi - lo).max()))
+    mid = 0.5 * (lo + hi)
+    lo, hi = mid - 0.5 * span, mid + 0.5 * span
+    axes_w = 5.2
+    h_top, h_side = axes_w * span[1] / span[0], max(axes_w * span[2] / span[0], 0.45)
+    fig = new_figure(axes_w + 2.4, h_top + h_side + 1.5)
+    top, side = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [h_top, h_side]})
     mappable = None
     for ax, (i, j), name in ((top, (0, 1), "top"), (side, (0, 2), "side")):
         # an (E, 2, 2) array is a valid segment list; the stubs only accept a Sequence
         coll = LineCollection(pos[e][:, :, [i, j]], linewidths=linewidth)  # type: ignore[arg-type]
-        mappable = _style(coll, values, e, len(pos), cmap, vmin, vmax, color)
+        mappable = _style(coll, values, e, len(pos), cmap, vmin, vmax, color, norm)
         ax.add_collection(coll)
-        ax.autoscale_view()
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x (mm)")
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[j], hi[j])
+        ax.set_aspect("equal", adjustable="box")
         ax.set_ylabel("y (mm)" if name == "top" else "z (mm)")
-        ax.set_title(f"{name} view")
+        ax.set_title(f"{name} view", fontsize=10, loc="left")
+    side.set_xlabel("x (mm)")
+    fig.set_layout_engine("constrained")
     if title:
         fig.suptitle(title)
     if mappable is not None:
-        fig.colorbar(mappable, ax=[top, side], shrink=0.8, label=label)
+        extend = colourbar_extend(mappable.norm, mappable.get_array())
+        fig.colorbar(
+            mappable, ax=[top, side], shrink=0.8, label=label, extend=extend,
+            ticks=colourbar_ticks(mappable.norm),
+        )  # fmt: skip
     return fig

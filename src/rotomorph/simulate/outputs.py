@@ -37,6 +37,7 @@ import numpy as np
 
 from rotomorph.io.results import RunResults, summarize, write_results, write_summary
 from rotomorph.io.validity import StepVerdict, assess, run_verdict
+from rotomorph.io.vtk import network_lines
 from rotomorph.simulate.paraview import write_vtk
 
 #: Phase messages of the writing steps (a command line shows them; silent by default).
@@ -55,18 +56,31 @@ __all__ = [
 #: Tube radius (mm) when a results file does not store one.
 DEFAULT_RADIUS = 0.3
 _RED = "#b2182b"
-#: Height over width of a filament panel: a filament's box is long and flat, a square panel
-#: would be mostly empty.
-FILAMENT_PANEL_HEIGHT = 0.6
 
 
 def colour_field(results: RunResults) -> tuple[str | None, str]:
     """Name of the per-node field used to colour shapes and its label, if any."""
+    from rotomorph.plot.shapes import RELATIVE_CHANGE_LABEL
+
     if "relative_curvature_change" in results.fields:
-        return "relative_curvature_change", "(κ − κ_i)/κ_i"
+        return "relative_curvature_change", RELATIVE_CHANGE_LABEL
     if "curvature" in results.fields:
-        return "curvature", "κ (1/mm)"
+        return "curvature", "curvature κ (1/mm)"
     return None, ""
+
+
+def _colour_norm(results: RunResults, name: str, values: np.ndarray) -> Any:
+    """Colour limits of per-segment ``values`` of field ``name`` (the relative curvature
+    change on the values where the lattice was printed clearly curved)."""
+    from rotomorph.plot.shapes import relative_change_norm, scalar_norm, segment_values
+    from rotomorph.simulate.paraview import centreline_curvature
+
+    if name != "relative_curvature_change":
+        return scalar_norm(values)
+    lines = network_lines(results.edges, results.branch)
+    printed = centreline_curvature(results.positions[:1], lines)[0]
+    printed_seg = segment_values(printed, results.edges)
+    return relative_change_norm(values, np.broadcast_to(printed_seg, values.shape))
 
 
 def _kind(results: RunResults) -> str:
@@ -213,7 +227,6 @@ def _shapes_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
         suptitle=title,
         suptitle_colour=colour,
         columns=min(len(panels), 4),
-        panel_height=FILAMENT_PANEL_HEIGHT * 3.6,
     )
 
 
@@ -221,7 +234,7 @@ def _lattice_field_figure(results: RunResults, verdicts: list[StepVerdict]) -> A
     """The shapes of :func:`_shapes_figure` as tubes coloured by the curvature field (paper
     Fig. 4): one colour scale for all panels, set by the states that pass the checks, that
     round-off cannot stretch."""
-    from rotomorph.plot.shapes import scalar_norm, segment_values
+    from rotomorph.plot.shapes import segment_values
     from rotomorph.plot.tubes import plot_tube_panels
 
     name, label = colour_field(results)
@@ -233,7 +246,7 @@ def _lattice_field_figure(results: RunResults, verdicts: list[StepVerdict]) -> A
     # the scale of the states that pass the checks (a state that is not physical may reach any
     # value; it is clipped to this scale rather than setting it)
     scaled = [k for k in steps if verdicts[k].verdict != "no" and k > 0] or steps
-    norm = scalar_norm(np.concatenate([values[k] for k in scaled]))
+    norm = _colour_norm(results, name, np.stack([values[k] for k in scaled]))
     panels = []
     for k in steps:
         head = "printed" if k == 0 else ("end of ramp" if k == last else "before the failure")
@@ -282,7 +295,6 @@ def _ramp_figure(results: RunResults, verdicts: list[StepVerdict]) -> Any:
         panels,
         columns=len(steps),
         panel_size=3.0,
-        panel_height=FILAMENT_PANEL_HEIGHT * 3.0,
         suptitle=f"Heating ramp{note}",
         suptitle_colour=_RED if v.verdict == "no" else "k",
     )
@@ -357,7 +369,7 @@ def _lattice_metrics_figure(results: RunResults, verdicts: list[StepVerdict]) ->
     left.set_title("Projected area")
     left.grid(alpha=0.3)
     right.set_xlabel("mean edge strain (–)")
-    right.set_ylabel("√|k1 k2| (1/mm)")
+    right.set_ylabel("characteristic curvature √|k₁k₂| (1/mm)")
     sign = sc.get("gaussian_sign", np.zeros(1))[-1]
     right.set_title(f"Characteristic curvature (Gaussian sign at end {sign:+.0f})")
     right.grid(alpha=0.3)
@@ -371,14 +383,17 @@ def _lattice_metrics_figure(results: RunResults, verdicts: list[StepVerdict]) ->
 
 
 def _lattice_views(results: RunResults, verdicts: list[StepVerdict]) -> Any:
-    from rotomorph.plot.shapes import plot_lattice_views
+    from rotomorph.plot.shapes import plot_lattice_views, segment_values
 
     name, label = colour_field(results)
     last = results.n_steps - 1
     values = None if name is None else results.fields[name][last]
+    norm = None
+    if name is not None and values is not None and len(values) == results.positions.shape[1]:
+        norm = _colour_norm(results, name, segment_values(values, results.edges))
     title, _ = _state_title(results, last, verdicts)
     return plot_lattice_views(
-        results.positions[last], results.edges, values, label=label, title=title
+        results.positions[last], results.edges, values, label=label, title=title, norm=norm
     )
 
 

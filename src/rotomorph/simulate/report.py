@@ -856,7 +856,7 @@ def _lattice_section(
                 physical=_end_physical(res)[0],
                 physical_reason=_end_physical(res)[1],
                 note=why
-                or "√|k1 k2| of the branch-node surface fit at mean edge strain "
+                or "√|k₁k₂| of the branch-node surface fit at mean edge strain "
                 f"{res.mean_edge_strain[-1]:+.3f}; the paper gives this only as a plot",
             )
         )
@@ -916,7 +916,7 @@ def _lattice_section(
                     ),
                 )
         ax.set_xlabel("mean edge strain (–)")
-        ax.set_ylabel("√|k1 k2| (1/mm)")
+        ax.set_ylabel("characteristic curvature √|k₁k₂| (1/mm)")
         got = "" if res is None else f", simulated sign {int(res.gaussian_sign[-1]):+d}"
         title, colour = _flagged(
             f"Fig. {panel}: {pattern} pattern (paper: κ_g {'>' if sign > 0 else '<'} 0{got})", res
@@ -991,6 +991,12 @@ def _fmt(v: Any) -> str:
     if isinstance(v, float):
         return f"{v:.4g}"
     return str(v)
+
+
+def _table_cell(text: str) -> str:
+    """``text`` as one cell of a Markdown table: a ``|`` in it (as in √|k₁k₂|) is escaped, so
+    it renders as itself instead of splitting the cell."""
+    return str(text).replace("|", "\\|")
 
 
 def _markdown(
@@ -1092,9 +1098,9 @@ def _markdown(
                     if r.get("extrapolated")
                     else ""
                 )
-                + r["note"].replace("|", "/"),
+                + r["note"],
             ]
-            lines.append("| " + " | ".join(cells) + " |")
+            lines.append("| " + " | ".join(map(_table_cell, cells)) + " |")
         lines.append("")
         for fig in dict.fromkeys(r["figure"] for r in sel):
             if fig in names:

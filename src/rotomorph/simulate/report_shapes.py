@@ -101,7 +101,6 @@ def filament_shapes_figure(
         panels,
         columns=len(omegas),
         panel_size=3.2,
-        panel_height=2.0,
         elev=24.0,
         azim=-70.0,
         facets=12,
@@ -129,15 +128,16 @@ def lattice_tube_figure(
     result
         Its :class:`~rotomorph.lattice.heating.HeatingResult`.
     values
-        Per-node (κ − κ_i)/κ_i at the end of the ramp ``(N,)``.
+        Per-node (κ − κᵢ)/κᵢ at the end of the ramp ``(N,)`` (κᵢ: curvature as printed).
     title, title_colour
         Figure title and its colour.
     """
     from dataclasses import replace
 
     from rotomorph.lattice.model import interface_normals
-    from rotomorph.plot.shapes import scalar_norm, segment_values
+    from rotomorph.plot.shapes import RELATIVE_CHANGE_LABEL, relative_change_norm, segment_values
     from rotomorph.plot.tubes import TubePanel, plot_tube_panels
+    from rotomorph.simulate.paraview import centreline_curvature
     from rotomorph.simulate.run_data import active_normals
 
     k = len(result.positions) - 1
@@ -170,16 +170,18 @@ def lattice_tube_figure(
         active_fraction=float(lattice.active_fraction),
     )
     side = replace(oblique, title="side view", view=(4.0, -90.0))
-    field = replace(oblique, values=seg, title="(κ − κ_i)/κ_i")
+    chains = [np.asarray(c) for c in lattice.edge_chains]
+    printed = segment_values(centreline_curvature(result.positions[:1], chains)[0], edges)
+    printed = np.tile(printed, len(seg) // len(printed))  # every layer of a stack alike
+    field = replace(oblique, values=seg, title="relative curvature change")
     return plot_tube_panels(
         [oblique, side, field],
         columns=3,
         panel_size=3.6,
-        panel_height=2.4,
         facets=10,
         dpi=DPI,
-        norm=scalar_norm(seg),
-        label="(κ − κ_i)/κ_i",
+        norm=relative_change_norm(seg, printed),
+        label=RELATIVE_CHANGE_LABEL,
         cmap="coolwarm",
         suptitle=title,
         suptitle_colour=title_colour,

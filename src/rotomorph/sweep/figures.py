@@ -140,10 +140,33 @@ def plot_curve(
         ax.set_xlabel(parameter + _unit(table, parameter))
         ax.set_ylabel(out + _unit(table, out))
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+    _one_legend(fig, list(axes))
     if title:
         fig.suptitle(title)
+    fig.set_layout_engine("constrained")
     return fig
+
+
+def _one_legend(fig: Any, axes: Sequence[Any]) -> None:
+    """One legend for all panels (each entry once): inside a single panel, below several;
+    none where the only entry would be the one curve."""
+    entries: dict[str, Any] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    if list(entries) in ([], ["rotomorph"]):
+        return
+    if len(axes) == 1:
+        axes[0].legend(entries.values(), entries.keys(), fontsize=7)
+        return
+    fig.legend(
+        entries.values(),
+        entries.keys(),
+        loc="outside lower center",
+        ncol=min(len(entries), 4),
+        fontsize=8,
+        frameon=False,
+    )
 
 
 def _draw_curve(ax: Any, x: np.ndarray, y: np.ndarray, colour: str, label: str) -> None:

@@ -90,7 +90,7 @@ METRICS: tuple[Metric, ...] = (
     Metric("residual", "1", "float", "filament", "relative residual at the last step"),
     Metric("area_ratio", "1", "float", "lattice", "projected area A/A0"),
     Metric("gaussian_sign", "1", "int", "lattice", "+1 dome, -1 saddle, 0 flat"),
-    Metric("characteristic_curvature", "1/mm", "float", "lattice", "√|k1 k2| of the surface fit"),
+    Metric("characteristic_curvature", "1/mm", "float", "lattice", "√|k₁k₂| of the surface fit"),
     Metric("edge_strain", "1", "float", "lattice", "mean end-to-end strain of the edges"),
     Metric("min_clearance", "diameters", "float", "lattice", "closest non-adjacent segments"),
     Metric("stable", "", "bool", "lattice", "last step verified stable (null: not checked)"),
