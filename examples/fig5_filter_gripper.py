@@ -247,7 +247,7 @@ def figure(filter_rows: list[dict], gripper_rows: list[dict], path: Path) -> Non
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("--full", action="store_true", help="the paper's 5 x 5 lattices")
     parser.add_argument("--figure", type=Path, help="write the figure (PNG) here")
     args = parser.parse_args(argv)
@@ -265,4 +265,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    main()  # always 0; not SystemExit, which would end a documentation build running it

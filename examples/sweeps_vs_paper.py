@@ -42,7 +42,8 @@ from rotomorph.plot.figure import save_figure
 from rotomorph.sweep import Sweep, load_sweep, local_executor, run_sweep
 from rotomorph.sweep.figures import plot_curve, plot_heatmap, plot_phase_diagram
 
-HERE = Path(__file__).resolve().parent / "sweeps"
+#: The sweep files (sphinx-gallery runs examples without ``__file__``, from this folder).
+HERE = Path(globals().get("__file__", "sweeps_vs_paper.py")).resolve().parent / "sweeps"
 
 
 def with_model(sweep: Sweep, model: str) -> Sweep:
@@ -109,7 +110,7 @@ def compare(
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=(__doc__ or "").strip().partition("\n")[0])
     parser.add_argument("-o", "--output", default="sweeps_out", help="output folder")
     parser.add_argument("--quick", action="store_true", help="few points, coarse (for tests)")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes")
@@ -193,4 +194,4 @@ def run_all(janus: Sweep, rotation: Sweep, phase: Sweep, out: Path, figs: Path, 
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    main()  # always 0; not SystemExit, which would end a documentation build running it

@@ -46,3 +46,13 @@ def test_rod_basics_example(capsys):
         length - 0.5 * length / (nodes - 1), stiffness, 2e-4, weight
     )
     assert cantilever["tip_deflection_mm"] == pytest.approx(expected, rel=1e-3)
+
+
+def test_figure_draws_both_shapes(tmp_path):
+    """The gallery's figure of the example (``--figure``): a non-blank PNG."""
+    from PIL import Image
+
+    module = runpy.run_path(str(EXAMPLE))
+    module["figure"](41, tmp_path / "rod.png")
+    image = Image.open(tmp_path / "rod.png")
+    assert image.width > 600 and len(set(image.convert("L").getdata())) > 10

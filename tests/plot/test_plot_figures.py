@@ -13,7 +13,7 @@ from PIL import Image
 from rotomorph.errors import InvalidParameterError
 from rotomorph.plot.animate import animate_gif
 from rotomorph.plot.figure import figure_to_rgb, save_figure
-from rotomorph.plot.report import plot_measured_vs_predicted
+from rotomorph.plot.report import plot_measured_vs_predicted, plot_parity
 from rotomorph.plot.shapes import plot_lattice_views, plot_network_3d, segment_values
 
 
@@ -123,6 +123,29 @@ def test_measured_vs_predicted_rejects_mismatch():
         plot_measured_vs_predicted([1, 2], [1], None, [1, 2], xlabel="x", ylabel="y")
     with pytest.raises(InvalidParameterError, match="spread"):
         plot_measured_vs_predicted([1, 2], [1, 2], [-1, 1], [1, 2], xlabel="x", ylabel="y")
+
+
+def test_parity_panels_never_mix_scales():
+    """One panel per unit; a sign and a row without a unit each get their own, and rows
+    without a measurement are left out."""
+    rows = [
+        {"quantity": "curvature", "unit": "1/mm", "measured": 0.2, "predicted": 0.25},
+        {"quantity": "ratio", "unit": "1", "measured": 0.7, "predicted": 0.6, "counted": True},
+        {"quantity": "lattice_gaussian_sign", "unit": "1", "measured": 1.0, "predicted": 1.0},
+        {"quantity": "area change (%)", "unit": None, "measured": 99.0, "predicted": 88.0},
+        {"quantity": "unmeasured", "unit": "mm", "measured": None, "predicted": 1.0},
+    ]
+    fig = plot_parity(rows, title="t")
+    labels = [ax.get_xlabel() for ax in fig.axes]
+    assert labels == [
+        "measured (1/mm)",
+        "measured (–)",
+        "measured sign (–)",
+        "measured area change (%)",
+    ]
+    assert figure_to_rgb(fig).std() > 0
+    with pytest.raises(InvalidParameterError, match="rows"):
+        plot_parity(rows[-1:])
 
 
 def test_save_figure_rejects_unknown_suffix_and_is_atomic(tmp_path):
