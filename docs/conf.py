@@ -1,16 +1,25 @@
 """Sphinx configuration of the rotomorph documentation.
 
-Build with ``sphinx-build -W -b html docs docs/_build/html`` from the repository root. The
-example gallery is generated from ``examples/*.py`` by sphinx-gallery; examples are executed
-only when ``ROTOMORPH_DOCS_RUN_EXAMPLES=1`` (the test-suite already runs every example), and
-the tutorial notebook is executed on every build.
+Build with ``python -m sphinx -W -q -b html docs docs/_build/html`` from the repository root.
+Every build executes the tutorials (MyST notebooks, myst-nb) and the example gallery
+(``examples/*.py``, sphinx-gallery) with their small defaults, so what the pages show is what
+the code does today. An example writes its figures into ``docs/_build/gallery_outputs/<name>``
+(the arguments :func:`gallery_argv` gives it), and :func:`files_scraper` puts each new PNG on
+the example's page; the first one is its thumbnail. ``ROTOMORPH_DOCS_RUN_EXAMPLES=0`` skips the
+examples (placeholder thumbnails) for a quick look at text changes.
+
+Theme: pydata-sphinx-theme, the theme of NumPy, SciPy, matplotlib and pandas (BSD-3): the
+navigation a scientific Python user already knows, a page table of contents, and styles for
+sphinx-gallery and notebook outputs.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
@@ -35,7 +44,14 @@ extensions = [
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
-exclude_patterns = ["_build", "gallery_auto/*.ipynb", "**.ipynb_checkpoints", "gallery/*.png"]
+exclude_patterns = [
+    "_build",
+    "gallery_auto/*.ipynb",
+    "gallery_auto/*.py",
+    "**.ipynb_checkpoints",
+    "gallery/*.png",
+    "jupyter_execute",
+]
 root_doc = "index"
 
 myst_enable_extensions = ["dollarmath", "amsmath", "deflist"]
@@ -53,19 +69,110 @@ numpydoc_xref_param_type = False
 
 intersphinx_mapping: dict[str, tuple[str, None]] = {}
 
-_run_examples = os.environ.get("ROTOMORPH_DOCS_RUN_EXAMPLES", "0") == "1"
+_run_examples = os.environ.get("ROTOMORPH_DOCS_RUN_EXAMPLES", "1") == "1"
+#: Where the gallery's examples write their figures (one folder per example).
+GALLERY_OUTPUTS = ROOT / "docs" / "_build" / "gallery_outputs"
+#: The arguments each example runs with in the gallery: its small default and where to put the
+#: figures (quick modes as the test-suite runs them).
+GALLERY_ARGS = {
+    "rod_basics": ["--figure", "{out}/rod_basics.png"],
+    "stability_modes": ["--figure", "{out}/stability_modes.png"],
+    "filaments_vs_paper": ["--figure", "{out}/filaments_vs_paper.png"],
+    "lattices_vs_paper": ["--quick", "--figure", "{out}/lattices_vs_paper.png"],
+    "fig5_filter_gripper": ["--figure", "{out}/fig5_filter_gripper.png"],
+    "sweeps_vs_paper": ["--quick", "-o", "{out}"],
+}
+
+
+def _outputs(src_file: str) -> Path:
+    return GALLERY_OUTPUTS / Path(src_file).stem
+
+
+def gallery_argv(gallery_conf: dict[str, Any], script_vars: dict[str, Any]) -> list[str]:
+    """``sys.argv[1:]`` of an example in the gallery (a fresh, empty output folder)."""
+    out = _outputs(script_vars["src_file"])
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
+    args = GALLERY_ARGS.get(Path(script_vars["src_file"]).stem, [])
+    return [a.format(out=out) for a in args]
+
+
+class FilesScraper:
+    """sphinx-gallery image scraper: the PNG files an example wrote into its output folder
+    since the last code block, in name order (the figures a user running it gets)."""
+
+    def __init__(self) -> None:
+        self.seen: set[Path] = set()
+
+    def __repr__(self) -> str:  # stable, so sphinx-gallery's config cache key is too
+        return "FilesScraper()"
+
+    def __call__(self, block: Any, block_vars: dict[str, Any], gallery_conf: dict[str, Any]) -> str:
+        from sphinx_gallery.scrapers import figure_rst
+
+        out = _outputs(block_vars["src_file"])
+        new = sorted(p for p in out.rglob("*.png") if p not in self.seen)
+        self.seen.update(new)
+        images = []
+        for png, target in zip(new, block_vars["image_path_iterator"], strict=False):
+            shutil.copyfile(png, target)
+            images.append(target)
+        return figure_rst(images, gallery_conf["src_dir"])
+
+
+files_scraper = FilesScraper()
+
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": "gallery_auto",
-    "filename_pattern": r"/.*\.py" if _run_examples else r"^$",
+    # every example but the published sweep (a minute of CPU: its page shows the stored figures)
+    "filename_pattern": r"/(?!published_fig4)[^/]*\.py$" if _run_examples else r"^$",
     "plot_gallery": "True" if _run_examples else "False",
     "download_all_examples": False,
     "within_subsection_order": "FileNameSortKey",
     "remove_config_comments": True,
     "min_reported_time": 10,
+    "reset_argv": gallery_argv,
+    "image_scrapers": (files_scraper,),
+    "matplotlib_animations": False,
+    "capture_repr": (),
+    "show_memory": False,
 }
 
-html_theme = "alabaster"
+html_theme = "pydata_sphinx_theme"
 html_title = f"rotomorph {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["rotomorph.css"]
+html_theme_options = {
+    "navigation_with_keys": False,
+    "show_toc_level": 2,
+    "navbar_align": "left",
+    "header_links_before_dropdown": 6,
+    "secondary_sidebar_items": ["page-toc"],
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+}
+html_sidebars = {"index": [], "changelog": []}
+html_show_sourcelink = False
 suppress_warnings = ["config.cache"]
+
+
+def _inks_slot(app: Any, docname: str, source: list[str]) -> None:
+    """The tutorials page links and lists the bring-your-own-ink guide (``docs/inks.md``)
+    where the checkout has it, and says it is to come where not."""
+    if docname != "tutorial" or not (ROOT / "docs" / "inks.md").is_file():
+        return
+    text = source[0]
+    start, end = text.find("<!-- inks:"), text.find("<!-- inks: end -->")
+    if start < 0 or end < 0:
+        return
+    line = (
+        "[Your own inks](inks.md): measure your inks, write them as a materials file and "
+        "calibrate the model on your measurements.\n"
+    )
+    text = text[:start] + line + text[end + len("<!-- inks: end -->") :]
+    source[0] = text.replace("tutorials/sweeps\n```", "tutorials/sweeps\ninks\n```")
+
+
+def setup(app: Any) -> None:
+    app.connect("source-read", _inks_slot)
