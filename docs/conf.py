@@ -125,7 +125,7 @@ files_scraper = FilesScraper()
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": "gallery_auto",
-    # every example but the published sweep (a minute of CPU: its page shows the stored figures)
+    # every example but the published sweep (25 s of CPU: its page shows the stored figures)
     "filename_pattern": r"/(?!published_fig4)[^/]*\.py$" if _run_examples else r"^$",
     "plot_gallery": "True" if _run_examples else "False",
     "download_all_examples": False,
@@ -147,7 +147,7 @@ html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,
     "navbar_align": "left",
-    "header_links_before_dropdown": 6,
+    "header_links_before_dropdown": 3,  # Tutorials, Examples, Theory; the rest under More
     "secondary_sidebar_items": ["page-toc"],
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
