@@ -23,7 +23,10 @@ The two commands that install the package and run this very test suite are prove
 (``.ci/run`` runs the README's install line and test command, checked here to be the
 README's); every other command runs here exactly as written and must exit 0. Among them is the
 documentation build with ``-W`` (every warning an error), which executes the example gallery
-and the tutorial notebook, so the tutorial cannot rot either.
+and the tutorials, so neither can rot; the tutorials' page and the gallery index are then opened
+in headless Chromium (a real browser, not a parser): every image loads, the gallery thumbnails
+are the examples' own figures (not sphinx-gallery's placeholder) and no code or output block
+scrolls sideways.
 """
 
 from __future__ import annotations
@@ -417,7 +420,7 @@ PROMISED = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("block", _block_params())
-def test_readme_commands_run_verbatim(block, tmp_path):
+def test_readme_commands_run_verbatim(block, tmp_path, require_tool):
     """Every command of a README bash block runs as written, in order, in a fresh copy of the
     tracked files, under the install line that governs the block, and exits 0."""
     if shutil.which("git") is None or not (ROOT / ".git").exists():
@@ -451,6 +454,82 @@ def test_readme_commands_run_verbatim(block, tmp_path):
     if block.section == "Documentation":
         html = repo / "docs" / "_build" / "html"
         assert any((html / "api" / "generated").glob("rotomorph.rod.model*.html"))
+        for name in ("filament", "lattice", "gcode", "inverse", "sweeps"):
+            assert (html / "tutorials" / f"{name}.html").is_file()
+        gallery = (html / "gallery_auto" / "index.html").read_text(encoding="utf-8")
+        thumbs = re.findall(r'src="([^"]*thumb[^"]*\.png)"', gallery)
+        assert len(thumbs) >= 7, thumbs
+        placeholders = _placeholder_thumbnails(tmp_path)
+        for thumb in thumbs:
+            png = (html / "gallery_auto" / thumb).read_bytes()
+            assert png not in placeholders, f"{thumb}: sphinx-gallery's placeholder, not a figure"
+        for page in (html / "gallery_auto").glob("*.html"):
+            if page.stem not in ("index", "sg_execution_times", "published_fig4"):
+                text = page.read_text(encoding="utf-8")
+                assert "sphx-glr-single-img" in text, f"{page.name}: no figure (not executed)"
+        _assert_pages_render(html, require_tool("chromium", "apt-get install chromium"))
+
+
+def _placeholder_thumbnails(tmp: Path) -> set[bytes]:
+    """The thumbnails sphinx-gallery makes where an example drew nothing or failed: its stock
+    pictures scaled as it scales them."""
+    import sphinx_gallery
+    from sphinx_gallery.gen_rst import scale_image
+
+    static = Path(sphinx_gallery.__file__).parent / "_static"
+    out = set()
+    for stock in ("no_image.png", "broken_example.png"):
+        scaled = tmp / f"placeholder_{stock}"
+        scale_image(str(static / stock), str(scaled), 400, 280)
+        out.add(scaled.read_bytes())
+    return out
+
+
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+def _assert_pages_render(html: Path, chromium: str) -> None:
+    """The tutorials' page, a tutorial and the gallery index in a real browser: a screenshot
+    that is not blank, every image loaded, no ``pre`` wider than its box."""
+    from PIL import Image
+    from playwright.sync_api import sync_playwright
+
+    pages = ["tutorial.html", "tutorials/filament.html", "gallery_auto/index.html"]
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=chromium, args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 900})
+            for name in pages:
+                page.goto((html / name).resolve().as_uri())
+                page.wait_for_load_state("load")
+                shot = html.parent / (name.replace("/", "_") + ".png")
+                page.screenshot(path=str(shot), full_page=True)
+                grey = Image.open(shot).convert("L")
+                assert len(set(grey.getdata())) > 50, f"{name}: a blank page"
+                broken = page.evaluate(
+                    "() => [...document.images].filter(i => !i.complete || i.naturalWidth === 0)"
+                    ".map(i => i.getAttribute('src'))"
+                )
+                assert not broken, f"{name}: images that do not load: {broken}"
+                wide = page.evaluate(
+                    "() => [...document.querySelectorAll('pre')]"
+                    ".filter(e => e.scrollWidth > e.clientWidth + 1).length"
+                )
+                assert wide == 0, f"{name}: {wide} code blocks scroll sideways"
+            shown = page.evaluate(
+                "() => [...document.querySelectorAll('.sphx-glr-thumbcontainer img')]"
+                ".map(i => i.naturalWidth)"
+            )
+            assert len(shown) >= 7 and min(shown) > 0, shown
+        finally:
+            browser.close()
 
 
 def test_every_runnable_block_has_its_promises_or_none():
