@@ -155,24 +155,3 @@ html_theme_options = {
 html_sidebars = {"index": [], "changelog": []}
 html_show_sourcelink = False
 suppress_warnings = ["config.cache"]
-
-
-def _inks_slot(app: Any, docname: str, source: list[str]) -> None:
-    """The tutorials page links and lists the bring-your-own-ink guide (``docs/inks.md``)
-    where the checkout has it, and says it is to come where not."""
-    if docname != "tutorial" or not (ROOT / "docs" / "inks.md").is_file():
-        return
-    text = source[0]
-    start, end = text.find("<!-- inks:"), text.find("<!-- inks: end -->")
-    if start < 0 or end < 0:
-        return
-    line = (
-        "[Your own inks](inks.md): measure your inks, write them as a materials file and "
-        "calibrate the model on your measurements.\n"
-    )
-    text = text[:start] + line + text[end + len("<!-- inks: end -->") :]
-    source[0] = text.replace("tutorials/sweeps\n```", "tutorials/sweeps\ninks\n```")
-
-
-def setup(app: Any) -> None:
-    app.connect("source-read", _inks_slot)
