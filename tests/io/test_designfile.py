@@ -101,6 +101,11 @@ def test_save_load_round_trip_is_atomic(tmp_path):
     options = design.gcode_options()
     assert options["design_hash"] == design.sha256()
     assert options["process"] == [Process(30.0, 30.0)] * len(design.to_programs())
+    # defaults nobody set stay placeholders through a save (the G-code header flags them)
+    assert all(p.placeholders for p in again.gcode_options()["process"])
+    assert [p.placeholders for p in again.gcode_options()["process"]] == [
+        p.placeholders for p in options["process"]
+    ]
 
 
 def test_controls_per_segment():

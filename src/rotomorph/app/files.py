@@ -5,9 +5,9 @@ server chose, and offered as those bytes:
 
 * the design file: the design's tables as the page holds them, written as TOML
   (``tomli_w``, as :func:`rotomorph.io.designfile.save_design` writes), after the same
-  validation as ``rotomorph validate``; values the person left unset stay unset (the nozzle's
-  placeholder pressures and dwells are still flagged in the G-code made from the file, where
-  ``save_design`` would write every default out);
+  validation as ``rotomorph validate``; values the person left unset stay unset, as
+  ``save_design`` leaves them (the nozzle's placeholder pressures and dwells are still
+  flagged in the G-code made from the file);
 * the G-code: the steps of ``rotomorph gcode DESIGN -o FILE [--machine PROFILE]`` —
   :func:`~rotomorph.io.gcode.check_materials`, :func:`~rotomorph.io.placement.check_placement`,
   :func:`~rotomorph.io.gcode.write_gcode` with the design's

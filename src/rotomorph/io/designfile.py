@@ -1021,8 +1021,13 @@ def with_spacing(design: Design, spacing: float) -> Design:
 
 
 def save_design(design: Design, path: str | FilePath) -> FilePath:
-    """Write ``design`` as TOML to ``path`` atomically (temp file + os.replace)."""
-    data = design.model_dump(mode="json", exclude_none=True)
+    """Write ``design`` as TOML to ``path`` atomically (temp file + os.replace).
+
+    Only what the design sets is written (defaults stay defaults when it is read back): a
+    default written out would read back as a chosen value, so a placeholder nozzle pressure
+    or dwell would no longer be flagged as one in the G-code's header.
+    """
+    data = design.model_dump(mode="json", exclude_none=True, exclude_unset=True)
     return atomic_write_text(path, tomli_w.dumps(data))
 
 
