@@ -12,10 +12,22 @@ differences on three mode and three speed variables; filaments: null, their desi
 direct), ``reachable`` / ``stable`` flags. Lattice cases also report ``cpu_s`` (process CPU
 time, which the machine's load does not inflate) and ``load_1min``.
 
-Targets: filament cases ≤ 5 s (the material response table is built once per session and
-reported separately as ``response-table``), 5 × 5 lattice cases ≤ 60 s on one core.
+Bath cases ``lattice-dome-bath`` and ``lattice-saddle-bath``: the same targets designed where
+the lattice lives (:func:`rotomorph.inverse.environment.design_in_bath`: self-contact, the bath
+floor, the buoyant weight in hot silicone oil, the lift probe's branch) and verified by the
+ramp ``rotomorph simulate`` runs on the design file (``heat_lattice``, its lift probe). Fields:
+``bath: true``, ``gaussian_curvature_error_rel`` (of that verified state), ``stack_overlaps``
+(interpenetrating layer pairs of the printed stack in it; null where the check is not
+available, then ``min_clearance_diameters``), ``stable``, ``admissible``, ``reached`` and
+``reason`` (with the measures when not reached: K without the weight, the weight-to-bending
+ratio, the rise off the floor), the calibration band ``gaussian_curvature_sd_calibration``,
+``cpu_s`` (the design, its verification and its band) and ``load_1min``.
 
-Run: ``python benchmarks/inverse.py [--quick]``.
+Targets: filament cases ≤ 5 s (the material response table is built once per session and
+reported separately as ``response-table``), 5 × 5 lattice cases ≤ 60 s on one core, bath cases
+|K| within 10 % of the target with every verified state admissible, ≤ 120 s CPU each.
+
+Run: ``python benchmarks/inverse.py [--quick] [--bath-only]``.
 """
 
 from __future__ import annotations
@@ -121,10 +133,55 @@ def lattice_case(name: str, pattern: str, target, iterations: int) -> None:  # t
     )
 
 
+def bath_case(name: str, pattern: str, target, iterations: int) -> None:  # type: ignore[no-untyped-def]
+    from rotomorph.inverse.environment import design_in_bath
+
+    lat = sinusoidal_lattice(n=5, spacing=5.0, amplitude=1.25, ghost_nodes=10, pattern=pattern)
+    load = os.getloadavg()[0]
+    t0, c0 = time.perf_counter(), time.process_time()
+    des = design_in_bath(lat, target, max_iterations=iterations)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    check, band = des.bath, des.band
+    assert check is not None and band is not None
+    _emit(
+        case=name,
+        bath=True,
+        n_design_variables=len(des.modes) + len(des.speeds),
+        iterations=des.iterations,
+        wall_s=round(wall, 3),
+        cpu_s=round(cpu, 3),
+        load_1min=round(load, 2),
+        target_metric=des.target_gaussian_curvature,
+        achieved_metric=check.gaussian_curvature,
+        gaussian_curvature_error_rel=check.error_rel,
+        gaussian_curvature_sd_calibration=band.gaussian_curvature_sd,
+        band=band.text(),
+        rms_error_rel=des.misfit_rel,
+        stack_overlaps=check.stack_overlaps,
+        min_clearance_diameters=check.min_clearance,
+        admissible=check.admissible,
+        stable=check.stable,
+        reached=check.reached,
+        reason=check.reason,
+        floor_lift_mm=check.floor_lift,
+        weightless_gaussian_curvature=check.weightless_gaussian_curvature,
+        weight_to_bending=check.weight_to_bending,
+        verify_cpu_s=round(check.cpu_s, 3),
+        band_cpu_s=round(band.cpu_s, 3),
+        speed_range_mm_s=[float(des.speeds.min()), float(des.speeds.max())],
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer optimiser iterations")
+    parser.add_argument("--bath-only", action="store_true", help="only the bath cases")
     args = parser.parse_args()
+    its = 6 if args.quick else 20
+    if args.bath_only:
+        bath_case("lattice-dome-bath", "dome", dome(0.07), its)
+        bath_case("lattice-saddle-bath", "saddle", saddle(0.07), its)
+        return
     t0 = time.perf_counter()
     table = response_table(max_omega_star=1.5)
     _emit(case="response-table", wall_s=round(time.perf_counter() - t0, 3))
@@ -142,11 +199,12 @@ def main() -> None:
         CurveSpec(family="tendril", radius=0.5 * (r_lo + r_hi), pitch=1.5, turns=1.0),
         table,
     )
-    its = 6 if args.quick else 20
     # |K| = 4.9e-3 1/mm² for both: inside what the 5 x 5 patterns give at printable speeds
     # (the dome pattern alone: K = 6.5e-4 at 0.25 mm/s, 1.1e-2 at 0.5, 2.3e-2 at 3 mm/s)
     lattice_case("lattice-dome", "dome", dome(0.07), its)
     lattice_case("lattice-saddle", "saddle", saddle(0.07), its)
+    bath_case("lattice-dome-bath", "dome", dome(0.07), its)
+    bath_case("lattice-saddle-bath", "saddle", saddle(0.07), its)
 
 
 if __name__ == "__main__":

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from scipy.interpolate import RectBivariateSpline
@@ -51,6 +51,7 @@ from rotomorph.design.lattices import Lattice
 from rotomorph.errors import ConvergenceError, InvalidDesignError, InvalidParameterError
 from rotomorph.geometry import best_rotation
 from rotomorph.inverse.adjoint import NotAMinimumError, adjoint
+from rotomorph.inverse.bath import BathCheck
 from rotomorph.inverse.blend import LatticeBlend, lattice_blend, with_settings
 from rotomorph.lattice.actuation import Actuation
 from rotomorph.lattice.heating import contact_settings, perturbed_state, symmetry_breaking
@@ -83,7 +84,13 @@ __all__ = [
     "surroundings",
 ]
 
+if TYPE_CHECKING:
+    from rotomorph.inverse.environment import DesignBand, RobustChoice
+
 SOLVE_OPTIONS = NewtonOptions(rtol=1e-10, max_iterations=300)
+
+#: Out-of-plane perturbation of the design ramps' flat start, relative to the spacing.
+DESIGN_PERTURBATION = 1e-2
 
 
 # ---------------------------------------------------------------------------------- targets
@@ -326,12 +333,15 @@ def surroundings(
     floor: bool | Floor = False,
     gravity: Gravity | None = None,
     seed: int = 0,
+    perturbation: float | None = None,
 ) -> Surroundings:
     """The forward solves' contact and loads, as :func:`rotomorph.lattice.heat_lattice`
     builds them from the same arguments (a ``floor=True`` lies just below the perturbed
     printed state), with the barrier stiffness fixed at its default for the printed lattice:
     a default scaled from each design's natural values would make the barrier depend on the
-    design, which the adjoint gradient leaves out.
+    design, which the adjoint gradient leaves out. ``perturbation`` (relative to the spacing;
+    default the design ramp's) sets the perturbed printed state the floor lies under:
+    :func:`~rotomorph.lattice.heat_lattice`'s own (1e-3) puts it where that ramp puts it.
 
     Raises
     ------
@@ -340,7 +350,8 @@ def surroundings(
         lattice without a floor to rest on.
     """
     lattice = blend.lattice
-    start = _Equilibria(blend, seed=seed)._flat(1.0)
+    scale = DESIGN_PERTURBATION if perturbation is None else perturbation
+    start = _Equilibria(blend, seed=seed, perturbation=scale)._flat(1.0)
     settings = contact_settings(lattice, start.positions, contact, floor, 0.0)
     if settings is not None and settings.friction > 0:
         raise InvalidParameterError(
@@ -373,17 +384,23 @@ class _Equilibria:
 
     A ramp that ends on an unstable equilibrium (a flat state past its buckling point, kept
     by symmetry) is repeated from a larger out-of-plane perturbation, up to ``retries`` times.
+    With ``heated`` (a function of the design returning a state, e.g. the end of
+    :func:`~rotomorph.lattice.heat_lattice`'s lowest-energy ramp of its printable rounding),
+    a fresh solve starts from that state instead, and falls back to the ramp where it is not
+    a stable equilibrium of the design.
     """
 
     def __init__(
         self,
         blend: LatticeBlend,
         seed: int = 0,
-        perturbation: float = 1e-2,
+        perturbation: float = DESIGN_PERTURBATION,
         retries: int = 3,
         env: Surroundings | None = None,
+        heated: Callable[[FloatArray], State] | None = None,
     ) -> None:
         self.blend = blend
+        self.heated = heated
         self.env = env or Surroundings()
         self.seed = seed
         self.perturbation = perturbation
@@ -410,6 +427,14 @@ class _Equilibria:
         return perturbed_state(self.blend.model, dz)
 
     def _ramp(self, p: FloatArray) -> StaticResult:
+        if self.heated is not None:
+            try:
+                res = self._solve(self.rod(p), self.heated(p))
+                if _is_minimum(self.rod(p), res.state, self.env):
+                    return res
+            except ConvergenceError:
+                pass
+
         def solve(t: float, state: State) -> StaticResult:
             return self._solve(self.rod(p, t), state)
 
@@ -491,6 +516,15 @@ class LatticeDesign:
         Whether the verified equilibrium's Hessian is positive semidefinite.
     iterations, solves
         Optimiser iterations and forward solves.
+    bath
+        The verification in the declared surroundings by the ramp ``simulate`` runs
+        (:func:`rotomorph.inverse.bath.verify_in_bath`; None where not run).
+    band
+        The calibration band of the verified shape
+        (:func:`rotomorph.inverse.environment.design_band`; None where not computed).
+    robust
+        With a robust design: what was chosen over the band and what it gives up nominally
+        (:class:`~rotomorph.inverse.environment.RobustChoice`).
     """
 
     lattice: Lattice
@@ -507,6 +541,16 @@ class LatticeDesign:
     stable: bool
     iterations: int
     solves: int
+    bath: BathCheck | None = None
+    band: DesignBand | None = None
+    robust: RobustChoice | None = None
+
+    @property
+    def reached(self) -> bool | None:
+        """Verified in the declared surroundings and reached (stable, admissible, K within
+        the tolerance: :class:`~rotomorph.inverse.bath.BathCheck`); None where the design was
+        not verified there."""
+        return None if self.bath is None else self.bath.reached
 
     @property
     def pattern(self) -> dict[int, str]:
@@ -674,17 +718,20 @@ def _verify(
     lattice: Lattice,
     eq: _Equilibria | None = None,
     env: Surroundings | None = None,
+    heated: Callable[[FloatArray], State] | None = None,
 ) -> _Check:
     """``p`` solved by ``eq`` (default: a fresh ramp from the flat printed state, as the
     forward simulation runs it, in ``env``; else warm-started from ``eq``'s last state)."""
-    fresh = _Equilibria(blend, seed=seed, env=env) if eq is None else eq
+    fresh = _Equilibria(blend, seed=seed, env=env, heated=heated) if eq is None else eq
     before = fresh.solves
     try:
         res = fresh(p)
     except ConvergenceError:
         if eq is None:
             raise
-        return _verify(blend, p, seed, target, picked, size, lattice, env=fresh.env)
+        return _verify(
+            blend, p, seed, target, picked, size, lattice, env=fresh.env, heated=fresh.heated
+        )
     return _Check(
         result=res,
         misfit=_misfit(target, res.positions, picked, size)[0],
@@ -693,6 +740,52 @@ def _verify(
         solves=fresh.solves - before,
         target_k=target.gaussian_curvature,
     )
+
+
+#: heat_lattice's default symmetry-breaking perturbation (relative to the spacing): the floor of
+#: a design on the lowest branch lies where that ramp puts it.
+HEAT_PERTURBATION = 1e-3
+
+
+def _heated_start(
+    blend: LatticeBlend,
+    actuation: str | Actuation | None,
+    contact: bool | Contact,
+    floor: bool | Floor,
+    gravity: Gravity | None,
+    seed: int,
+) -> Callable[[FloatArray], State]:
+    """``p ↦`` a start on the lowest branch: the end state of
+    :func:`~rotomorph.lattice.heat_lattice`'s lowest-energy ramp (its lift probe) of the first
+    design asked for, rounded to printable modes (±1, its speeds), in the same surroundings.
+    That ramp costs as much as ``simulate``'s, so it runs once; every later fresh solve starts
+    from its state (the design's final verification is ``simulate``'s ramp of its own)."""
+    from rotomorph.inverse.bath import VERIFY_STEPS
+    from rotomorph.lattice.heating import heat_lattice
+
+    act = actuation if actuation is not None else "program"
+    found: list[State] = []
+
+    def start(p: FloatArray) -> State:
+        if found:
+            return found[0]
+        c, v = split(blend, p)
+        printed = with_settings(blend.lattice, np.where(c >= 0, 1.0, -1.0), v)
+        res = heat_lattice(
+            printed,
+            actuation=act,
+            steps=VERIFY_STEPS,
+            contact=contact,
+            floor=floor,
+            gravity=gravity,
+            seed=seed,
+            perturbation=HEAT_PERTURBATION,
+            branch="lowest",
+        )
+        found.append(res.states[-1])
+        return found[0]
+
+    return start
 
 
 def design_lattice(
@@ -711,6 +804,7 @@ def design_lattice(
     contact: bool | Contact = False,
     floor: bool | Floor = False,
     gravity: Gravity | None = None,
+    branch: Literal["continuous", "lowest"] = "continuous",
 ) -> LatticeDesign:
     """Choose per-edge modes and print speeds that make ``lattice`` rise into ``target``.
 
@@ -750,6 +844,13 @@ def design_lattice(
         every equilibrium solve and in the adjoint (the barrier's Hessian is part of it), with
         the barrier stiffness fixed at its default for the printed lattice
         (:func:`surroundings`). Frictionless only.
+    branch
+        With a floor and a weight: ``"continuous"`` (default) follows the resting state from
+        the flat print, which a rigid floor never lets go by itself; ``"lowest"`` starts every
+        fresh solve of a design from the end of :func:`~rotomorph.lattice.heat_lattice`'s
+        lowest-energy ramp (its lift probe) of the design's printable rounding (modes ±1, the
+        same speeds) in the same surroundings, with its floor, so the optimiser works on the
+        branch ``simulate`` takes; the adjoint then differentiates that equilibrium.
 
     Notes
     -----
@@ -787,8 +888,19 @@ def design_lattice(
     _check_options(printability, speed_range, speed_resolution)
     blend = lattice_blend(lattice, actuation)
     size = lattice.spacing * (lattice.n - 1)
-    env = surroundings(blend, contact=contact, floor=floor, gravity=gravity, seed=seed)
-    eq = _Equilibria(blend, seed=seed, env=env)
+    if branch not in ("continuous", "lowest"):
+        raise InvalidParameterError("branch", f"must be 'continuous' or 'lowest'; got {branch!r}")
+    lifting = branch == "lowest" and gravity is not None
+    env = surroundings(
+        blend,
+        contact=contact,
+        floor=floor,
+        gravity=gravity,
+        seed=seed,
+        perturbation=HEAT_PERTURBATION if lifting else None,
+    )
+    heated = _heated_start(blend, actuation, contact, floor, gravity, seed) if lifting else None
+    eq = _Equilibria(blend, seed=seed, env=env, heated=heated)
     n_edges = blend.n_edges
     if initial is None:
         c0 = np.array([1.0 if m == "expanding" else -1.0 for m in lattice.edge_mode]) * 0.9
@@ -810,7 +922,8 @@ def design_lattice(
             np.full(n_edges, v) for v in np.geomspace(*speed_range, INITIAL_SPEEDS)
         ]
         signs0 = np.where(c0 >= 0, 1.0, -1.0)
-        scan = _Equilibria(blend, seed=seed, env=env)  # one ramp, then warm starts along the speeds
+        # one ramp, then warm starts along the speeds
+        scan = _Equilibria(blend, seed=seed, env=env, heated=heated)
         tried0 = [
             _verify(blend, np.concatenate([signs0, v]), seed, target, picked, size, lattice, scan)
             for v in starts
@@ -872,7 +985,8 @@ def design_lattice(
             0, np.concatenate([signs, _same_strength(blend, c_rel, v_rel, speed_range)])
         )
     scored = [
-        (_verify(blend, m, seed, target, picked, size, lattice, env=env), m) for m in candidates
+        (_verify(blend, m, seed, target, picked, size, lattice, env=env, heated=heated), m)
+        for m in candidates
     ]
     eq.solves += sum(check.solves for check, _ in scored)
     best_check, best = min(scored, key=lambda t: t[0].misfit if t[0].stable else np.inf)
@@ -896,7 +1010,7 @@ def design_lattice(
     # verification as the forward simulation does it: a fresh ramp from the flat printed state
     base = speeds
 
-    near = _Equilibria(blend, seed=seed, env=env)
+    near = _Equilibria(blend, seed=seed, env=env, heated=heated)
 
     def check_scale(scale: float) -> tuple[FloatArray, _Check]:
         v = base
@@ -930,7 +1044,15 @@ def design_lattice(
         # the chosen scale verified as the forward simulation runs it: a fresh ramp (kept only
         # if it is still better than the fresh base design)
         fresh = _verify(
-            blend, np.concatenate([modes, speeds]), seed, target, picked, size, lattice, env=env
+            blend,
+            np.concatenate([modes, speeds]),
+            seed,
+            target,
+            picked,
+            size,
+            lattice,
+            env=env,
+            heated=heated,
         )
         eq.solves += fresh.solves
         speeds, check = min([(speeds, fresh), tried[1.0]], key=lambda t: t[1].rank)

@@ -23,8 +23,10 @@ import numpy as np
 
 from rotomorph._typing import FloatArray
 from rotomorph.design.lattices import sinusoidal_lattice
+from rotomorph.inverse.bath import bath_contact
+from rotomorph.inverse.environment import design_in_bath
 from rotomorph.inverse.filament import FilamentDesign, design_filament
-from rotomorph.inverse.lattice import LatticeDesign, design_lattice
+from rotomorph.inverse.lattice import LatticeDesign
 from rotomorph.inverse.response import cached_response_table
 from rotomorph.inverse.simplify import (
     CONVENTION,
@@ -37,8 +39,7 @@ from rotomorph.inverse.targets import TargetFile, curve_points
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.design_limits import nozzle_table
 from rotomorph.io.designfile import ContactModel, Design, parse_design, save_design
-from rotomorph.lattice.actuation import ProgramActuation
-from rotomorph.simulate.surroundings import lattice_surroundings, surroundings_record
+from rotomorph.simulate.surroundings import surroundings_record
 
 #: What the inverse design is doing, for the command line's progress display.
 phase_log = logging.getLogger("rotomorph.progress")
@@ -313,21 +314,22 @@ def run_inverse(
         extra={"task": True},
     )
     surf = target.surface_target()
-    env = lattice_surroundings(target.contact, lat, opt.temperature, materials=target.material_set)
-    env.pop("friction", None)  # 0: the target file refuses friction
-    env.pop("branch", None)  # 'continuous' wherever it matters: the target file refuses the probe
-    env.pop("path_check", None)  # 1: the target file refuses a path check
-    fm = target.filament_model()
-    des = design_lattice(
+    # lattices are designed where they live: the declared [contact] table, else the bath
+    contact = bath_contact() if target.contact is None else target.contact
+    des = design_in_bath(
         lat,
         surf,
-        actuation=None if fm is None else ProgramActuation(filament_model=fm),
+        contact=contact,
+        temperature=opt.temperature,
+        robust=opt.robust,
+        filament_model=target.filament_model(),
+        materials=target.material_set,
         max_iterations=opt.max_iterations,
         speed_range=(opt.min_speed, opt.max_speed),
         speed_resolution=opt.speed_resolution,
         callback=cb,
-        **env,
     )
+    assert des.bath is not None
     k_t = des.target_gaussian_curvature
     k_a = des.achieved_gaussian_curvature
     summary = {
@@ -341,14 +343,21 @@ def run_inverse(
         "misfit_rms_mm": des.misfit_rms,
         "misfit_rel": des.misfit_rel,
         "stable": des.stable,
+        "reached": des.bath.reached,
+        "verified": des.bath.record(),
+        "band": None if des.band is None else des.band.record(),
+        "robust": None if des.robust is None else des.robust.record(),
         "iterations": des.iterations,
         "forward_solves": des.solves,
         "expanding_edges": int(np.sum(des.modes > 0)),
         "contracting_edges": int(np.sum(des.modes < 0)),
         "speed_range_mm_s": [float(des.speeds.min()), float(des.speeds.max())],
-        "contact": surroundings_record(target.contact, opt.temperature),
+        "contact": surroundings_record(contact, opt.temperature, along_ramp=True),
+        "designed_in": "optimised frictionless with self-contact, floor and weight as declared "
+        "(on the lift probe's branch), verified by the ramp rotomorph simulate runs on the "
+        "design file (its friction and path check included)",
     }
-    design_file = lattice_design_file(des, name, target.contact, target)
+    design_file = lattice_design_file(des, name, contact, target)
     return InverseRun(target, design_file, summary, log, des)
 
 
@@ -428,8 +437,30 @@ def inverse_file(
         )
     k_t, k_a = s["target_gaussian_curvature"], s["achieved_gaussian_curvature"]
     kt = "" if k_t is None else f"target K {k_t:.3g} 1/mm², "
-    stable = "stable" if s["stable"] else "NOT STABLE"
+    band = "" if s["band"] is None else f" ± {s['band']['gaussian_curvature_sd_calibration']:.2g}"
+    where = _surroundings_text(s["contact"])
+    verdict = "REACHED" if s["reached"] else f"NOT REACHED: {s['verified']['reason']}"
     return (
-        f"wrote {design_path} and {folder}/: {kt}achieved K {k_a:.3g} 1/mm², misfit "
-        f"{s['misfit_rms_mm']:.3g} mm ({100 * s['misfit_rel']:.2g} % of the size), {stable}"
+        f"wrote {design_path} and {folder}/: designed and verified {where} by simulate's "
+        f"ramp: {kt}verified K {k_a:.3g}{band} 1/mm² (calibration band), misfit "
+        f"{s['misfit_rms_mm']:.3g} mm ({100 * s['misfit_rel']:.2g} % of the size); {verdict}"
     )
+
+
+def _surroundings_text(record: dict[str, Any] | None) -> str:
+    """``in the bath (self-contact, floor, buoyant weight)`` from a surroundings record."""
+    if record is None:
+        return "free (no contact, no weight)"
+    parts = [
+        name
+        for name, key in (
+            ("self-contact", "self_contact"),
+            ("floor", "floor"),
+            ("buoyant weight", "gravity"),
+        )
+        if record.get(key)
+    ]
+    if record.get("friction"):
+        parts.append(f"friction {record['friction']:g}")
+    where = "in the bath" if record.get("gravity") else "in contact"
+    return f"{where} ({', '.join(parts) or 'no contact, no weight'})"

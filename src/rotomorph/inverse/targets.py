@@ -24,13 +24,16 @@ Curve families (all lengths in mm):
 Lattice targets (``dome``, ``saddle``, ``height_map``) give the curvatures (1/mm) or a height
 grid and a ``[lattice]`` table with the printed geometry (``n``, ``spacing``, ``amplitude``,
 ``ghost_nodes``; the paper does not give the last three, so they are assumptions of the design).
-An optional ``[contact]`` table (the design file's: ``self_contact``, ``floor``, ``gravity``,
-``bath``, ``branch``; frictionless only, no ``path_check``; with ``floor`` and ``gravity`` the
-branch must be ``"continuous"``) makes every equilibrium of a lattice design, and its adjoint,
-touch and rest as ``rotomorph simulate`` will; it is copied into the resulting design file.
 A lab's own inks: ``materials = "inks.toml"`` (a materials file, relative to the target file)
 and ``active_material``/``passive_material`` in ``[options]``; the design is then made with
 that file's model, and the resulting design file names the same materials file.
+Lattice designs are made in the surroundings of the ``[contact]`` table (the design file's:
+``self_contact``, ``floor``, ``gravity``, ``bath``, ``friction``, ``branch``, ``path_check``);
+without one, in the bath (self-contact, the bath floor, the buoyant weight, the lowest-energy
+branch: :func:`rotomorph.inverse.bath.bath_contact`). Every equilibrium of the design and its
+adjoint touch and rest as ``rotomorph simulate`` will (frictionless: friction and the path check
+apply to the verification, ``simulate``'s own ramp), and the table is copied into the resulting
+design file.
 """
 
 from __future__ import annotations
@@ -214,6 +217,11 @@ class Options(_Model):
     tolerance: float = Field(0.005, gt=0, le=0.2, allow_inf_nan=False)
     active_material: Label = Field("lce", min_length=1, max_length=100)
     passive_material: Label = Field("acrylate", min_length=1, max_length=100)
+    robust: bool = Field(
+        False,
+        description="lattices: choose the design minimising the expected misfit over the "
+        "calibration band instead of the nominal one",
+    )
 
 
 class TargetFile(_Model):
@@ -259,27 +267,6 @@ class TargetFile(_Model):
             raise ValueError(f"kind '{self.kind}' needs a [lattice] table (n, spacing, amplitude)")
         if self.contact is not None and self.kind == "curve":
             raise ValueError("[contact] applies to lattice targets only; remove it")
-        if self.contact is not None and self.contact.friction > 0:
-            raise ValueError(
-                "contact.friction must be 0: inverse design needs frictionless contact "
-                "(lagged friction has no adjoint gradient)"
-            )
-        if (
-            self.contact is not None
-            and self.contact.floor
-            and self.contact.gravity
-            and self.contact.branch != "continuous"
-        ):
-            raise ValueError(
-                "contact.branch must be 'continuous' with floor and gravity: inverse design "
-                "follows the resting state continuously (no lowest-energy lift probe); set "
-                'branch = "continuous" in [contact]'
-            )
-        if self.contact is not None and self.contact.path_check != 1:
-            raise ValueError(
-                "contact.path_check must be 1: inverse design follows one continuous path "
-                "(its adjoint differentiates that path); remove path_check from [contact]"
-            )
         if self.options.min_speed >= self.options.max_speed:
             raise ValueError("options.min_speed must be < options.max_speed (mm/s)")
         if self.kind == "curve":

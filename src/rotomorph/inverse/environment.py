@@ -1,0 +1,368 @@
+r"""Lattice designs made, verified and bounded in the surroundings the design declares.
+
+:func:`design_in_bath` optimises a lattice design with the physics ``rotomorph simulate``
+applies to its design file (:func:`rotomorph.inverse.lattice.design_lattice` with self-contact,
+the bath floor and the buoyant weight in the hot bath, on the branch ``simulate``'s lift probe
+takes), verifies the printable result with ``simulate``'s own ramp
+(:func:`rotomorph.inverse.bath.verify_in_bath`) and bounds its shape by the calibration
+(:func:`design_band`).
+
+The band
+--------
+The verified state is re-solved, warm-started, with the material model at the calibration's
+sigma points: the joint fit's optimum moved by ± one posterior standard deviation along each
+independent direction of its covariance (:meth:`rotomorph.materials.inference.Fit.directions`,
+as :mod:`rotomorph.prediction.band` does for filaments). The band's standard deviation of any
+output is that of the central secants, :math:`\sigma^2 = \sum_k ((y_k^+ - y_k^-)/2)^2`; the
+nominal value is the verified one (the package's default materials model, which ``simulate``
+uses). The band is the calibration's only: the lattice's geometry (spacing, amplitude), the
+bath's density and the printed stack are taken as given. The sigma-point solves follow the
+verified branch continuously (no lift probe) and are frictionless.
+
+Robust designs
+--------------
+With ``robust=True`` the design's overall bending strength (every edge's speed moved so that
+its Janus mismatch scales by a common factor, as the nominal design's last phase does) is
+chosen to minimise the *expected* squared relative error of K over the sigma points (equal
+weights on the ± points) instead of the nominal error; the chosen design is verified in the
+bath like the nominal one, and :class:`RobustChoice` records how much it gives up nominally.
+Only this one direction is searched for the expected misfit (each point of it costs one solve
+per sigma point); the per-edge pattern is the nominal optimum's.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from rotomorph._typing import FloatArray
+from rotomorph.analysis.curvature import fit_quadratic_surface
+from rotomorph.contact import Contact
+from rotomorph.design.lattices import Lattice
+from rotomorph.errors import ConvergenceError
+from rotomorph.inverse.bath import (
+    REACHED_TOLERANCE,
+    BathCheck,
+    bath_contact,
+    verify_in_bath,
+)
+from rotomorph.inverse.blend import lattice_blend, with_settings
+from rotomorph.inverse.lattice import (
+    MEASURED_SPEEDS,
+    LatticeDesign,
+    ShapeTarget,
+    SurfaceTarget,
+    _misfit,
+    _printable_speeds,
+    _same_strength,
+    design_lattice,
+)
+from rotomorph.lattice.actuation import ProgramActuation, default_stiffness, get_actuation
+from rotomorph.lattice.heating import lattice_buoyancy
+from rotomorph.lattice.model import lattice_model
+from rotomorph.rod.state import State
+from rotomorph.solve.loads import Loads
+from rotomorph.solve.newton import NewtonOptions
+from rotomorph.solve.static import solve_static
+
+__all__ = ["ROBUST_SCALES", "DesignBand", "RobustChoice", "design_band", "design_in_bath"]
+
+#: Overall strength factors a robust design is chosen among (1: the nominal design).
+ROBUST_SCALES = (0.85, 0.92, 1.0, 1.08, 1.16)
+
+_BAND_OPTIONS = NewtonOptions(rtol=1e-8, max_iterations=300)
+
+
+@dataclass(frozen=True, eq=False)
+class DesignBand:
+    """The calibration band of a verified lattice design (module docstring).
+
+    Attributes
+    ----------
+    gaussian_curvature
+        Nominal K (the verified state's, 1/mm²).
+    gaussian_curvature_sd
+        Its calibration standard deviation (1/mm²); NaN where a sigma-point solve failed.
+    sigma_points
+        K at each sigma point ``(2 p,)`` (+ then − along each direction; NaN: failed).
+    directions
+        Independent directions of the calibration covariance used (p).
+    failed
+        Sigma-point solves that did not converge.
+    cpu_s
+        Process CPU time of the band (s).
+    """
+
+    gaussian_curvature: float
+    gaussian_curvature_sd: float
+    sigma_points: FloatArray
+    directions: int
+    failed: int
+    cpu_s: float
+
+    def text(self) -> str:
+        """``K = 4.9e-03 ± 3.1e-04 1/mm² (calibration)``."""
+        return (
+            f"K = {self.gaussian_curvature:.3g} ± {self.gaussian_curvature_sd:.2g} 1/mm² "
+            "(calibration band)"
+        )
+
+    def record(self) -> dict[str, Any]:
+        """JSON-ready form."""
+
+        def num(x: float) -> float | None:
+            return float(x) if np.isfinite(x) else None
+
+        return {
+            "gaussian_curvature": num(self.gaussian_curvature),
+            "gaussian_curvature_sd_calibration": num(self.gaussian_curvature_sd),
+            "sigma_points": [num(float(k)) for k in self.sigma_points],
+            "directions": self.directions,
+            "failed_solves": self.failed,
+            "band_of": "the calibration's posterior (geometry, bath density and the printed "
+            "stack as given); sigma-point solves continue the verified branch, frictionless",
+            "cpu_s": round(self.cpu_s, 3),
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class RobustChoice:
+    """What a robust design chose (module docstring).
+
+    Attributes
+    ----------
+    scale
+        Overall strength factor chosen (1: the nominal design).
+    expected_error
+        Root of the expected squared relative K error over the sigma points, per scale tried.
+    nominal_error_robust, nominal_error_nominal
+        Relative K error of the robust and the nominal design at the nominal calibration,
+        both verified in the bath (``simulate``'s ramp).
+    gives_up
+        ``nominal_error_robust − nominal_error_nominal``: what the robust design gives up at
+        the nominal calibration (negative: it is better there too).
+    """
+
+    scale: float
+    expected_error: dict[float, float]
+    nominal_error_robust: float | None
+    nominal_error_nominal: float | None
+    gives_up: float | None
+
+    def record(self) -> dict[str, Any]:
+        """JSON-ready form."""
+        return {
+            "strength_scale": self.scale,
+            "expected_error_rel_by_scale": {
+                f"{k:g}": (float(v) if np.isfinite(v) else None)
+                for k, v in self.expected_error.items()
+            },
+            "nominal_error_rel_robust": self.nominal_error_robust,
+            "nominal_error_rel_nominal_design": self.nominal_error_nominal,
+            "gives_up_nominally": self.gives_up,
+        }
+
+
+def _calibration() -> tuple[Any, FloatArray]:
+    from rotomorph.prediction.band import calibration_fit
+
+    fit = calibration_fit()
+    dirs = [d for d in fit.directions().T if np.any(d)]
+    return fit, np.asarray(dirs)
+
+
+def _sigma_models(temperature: float) -> list[Any]:
+    fit, dirs = _calibration()
+    return [fit.model_at(fit.theta + s * d) for d in dirs for s in (1.0, -1.0)]
+
+
+def _heated_k(
+    lattice: Lattice,
+    model: Any,
+    temperature: float,
+    start: State,
+    contact: Contact | None,
+    loads: Loads | None,
+) -> float:
+    """K of ``lattice``'s equilibrium with the materials ``model``, from ``start``."""
+    act = replace(_program(temperature), filament_model=model)
+    stiffness, fm = default_stiffness(act)
+    lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
+    rod = act.natural(lm, act.end)
+    res = solve_static(rod, loads=loads, initial=start, options=_BAND_OPTIONS, contact=contact)
+    pos = np.asarray(res.positions)
+    return float(
+        fit_quadratic_surface(pos[lattice.branch_indices], flat_tolerance=1e-6).gaussian_curvature
+    )
+
+
+def _program(temperature: float) -> ProgramActuation:
+    base = get_actuation("program")
+    assert isinstance(base, ProgramActuation)
+    return replace(base, end=float(temperature))
+
+
+def _sigma_values(
+    lattice: Lattice, check: BathCheck, temperature: float, contact_model: Any
+) -> tuple[FloatArray, int]:
+    res = check.result
+    contact = None if res.contact is None else replace(res.contact, friction=0.0)
+    loads = None
+    if contact_model.gravity:
+        loads = Loads(gravity=lattice_buoyancy(lattice, bath=contact_model.bath)(temperature))
+    out = []
+    failed = 0
+    for model in _sigma_models(temperature):
+        try:
+            out.append(_heated_k(lattice, model, temperature, res.states[-1], contact, loads))
+        except ConvergenceError:
+            out.append(float("nan"))
+            failed += 1
+    return np.asarray(out), failed
+
+
+def design_band(
+    lattice: Lattice, check: BathCheck, contact: Any = None, *, temperature: float = 175.0
+) -> DesignBand:
+    """The calibration band of the printed ``lattice``'s verified state ``check`` (module
+    docstring), in the surroundings ``contact`` (a design file's ``[contact]`` table; default
+    the bath)."""
+    contact = bath_contact() if contact is None else contact
+    c0 = time.process_time()
+    ks, failed = _sigma_values(lattice, check, temperature, contact)
+    pairs = ks.reshape(-1, 2)
+    sd = float(np.sqrt(np.sum((0.5 * (pairs[:, 0] - pairs[:, 1])) ** 2)))
+    return DesignBand(
+        gaussian_curvature=check.gaussian_curvature,
+        gaussian_curvature_sd=sd,
+        sigma_points=ks,
+        directions=len(pairs),
+        failed=failed,
+        cpu_s=time.process_time() - c0,
+    )
+
+
+def _scaled(
+    design: LatticeDesign, scale: float, speed_range: tuple[float, float], resolution: float
+) -> Lattice:
+    blend = lattice_blend(design.lattice)
+    v = _same_strength(blend, scale * design.modes, design.speeds, speed_range)
+    v = _printable_speeds(v, speed_range, resolution)
+    return with_settings(design.lattice, design.modes, v)
+
+
+def design_in_bath(
+    lattice: Lattice,
+    target: SurfaceTarget | ShapeTarget,
+    *,
+    contact: Any = None,
+    temperature: float = 175.0,
+    tolerance: float = REACHED_TOLERANCE,
+    band: bool = True,
+    robust: bool = False,
+    speed_range: tuple[float, float] | None = MEASURED_SPEEDS,
+    speed_resolution: float = 0.05,
+    **options: Any,
+) -> LatticeDesign:
+    """Design ``lattice`` for ``target`` in the surroundings ``contact`` declares (a design
+    file's ``[contact]`` table; default :func:`~rotomorph.inverse.bath.bath_contact`: contact,
+    floor, buoyant weight, the lift probe), verify it by ``simulate``'s ramp and, with
+    ``band``, bound its shape by the calibration (module docstring).
+
+    ``options`` go to :func:`~rotomorph.inverse.lattice.design_lattice` (``max_iterations``,
+    ``printability``, ``seed``, ``nodes``, ``callback``). The optimiser is frictionless (lagged
+    friction has no adjoint); the verification applies the table's friction and path check.
+    The returned design's ``bath`` says whether it reached the target and, if not, why, with
+    the measures; a design whose verified state is unstable or interpenetrates is never
+    reported as reached.
+    """
+    contact = bath_contact() if contact is None else contact
+    gravity = None
+    if contact.gravity:
+        gravity = lattice_buoyancy(lattice, bath=contact.bath)(temperature)
+    floor = bool(contact.floor)
+    touch: bool | Contact = False
+    if contact.self_contact or floor:
+        touch = Contact(radius=lattice.radius, self_contact=bool(contact.self_contact))
+    des = design_lattice(
+        lattice,
+        target,
+        actuation=_program(temperature),
+        contact=touch,
+        floor=floor,
+        gravity=gravity,
+        branch=str(contact.branch) if gravity is not None else "continuous",  # type: ignore[arg-type]
+        speed_range=speed_range,
+        speed_resolution=speed_resolution,
+        **options,
+    )
+    k_t = target.gaussian_curvature
+    check = verify_in_bath(des.lattice, k_t, contact, temperature=temperature, tolerance=tolerance)
+    des = _verified(des, check, options.get("nodes", "branch"))
+    if band:
+        des = replace(des, band=design_band(des.lattice, check, contact, temperature=temperature))
+    if robust and k_t is not None and speed_range is not None:
+        des = _robust(des, contact, temperature, tolerance, speed_range, speed_resolution)
+    return des
+
+
+def _robust(
+    des: LatticeDesign,
+    contact: Any,
+    temperature: float,
+    tolerance: float,
+    speed_range: tuple[float, float],
+    resolution: float,
+) -> LatticeDesign:
+    """The strength scale of ``des`` minimising the expected K error over the sigma points."""
+    assert des.bath is not None and des.target_gaussian_curvature is not None
+    k_t = des.target_gaussian_curvature
+    base = des.bath
+    expected: dict[float, float] = {}
+    printed: dict[float, Lattice] = {}
+    for scale in ROBUST_SCALES:
+        lat = des.lattice if scale == 1.0 else _scaled(des, scale, speed_range, resolution)
+        printed[scale] = lat
+        ks, _ = _sigma_values(lat, base, temperature, contact)
+        rel = (ks - k_t) / k_t
+        expected[scale] = float(np.sqrt(np.mean(rel * rel))) if np.all(np.isfinite(rel)) else np.inf
+    best = min(expected, key=lambda s: expected[s])
+    nominal_err = base.error_rel
+    if best == 1.0:
+        choice = RobustChoice(1.0, expected, nominal_err, nominal_err, 0.0)
+        return replace(des, robust=choice)
+    check = verify_in_bath(
+        printed[best], k_t, contact, temperature=temperature, tolerance=tolerance
+    )
+    gives = (
+        None
+        if check.error_rel is None or nominal_err is None
+        else float(check.error_rel - nominal_err)
+    )
+    choice = RobustChoice(best, expected, check.error_rel, nominal_err, gives)
+    lat = printed[best]
+    out = _verified(replace(des, lattice=lat, speeds=np.asarray(lat.edge_speeds)), check, "branch")
+    return replace(
+        out, band=design_band(lat, check, contact, temperature=temperature), robust=choice
+    )
+
+
+def _verified(des: LatticeDesign, check: BathCheck, nodes: str) -> LatticeDesign:
+    """``des`` with the verified state, its misfit and K those of ``check``."""
+    lat = des.lattice
+    picked = np.asarray(lat.branch_indices) if nodes == "branch" else np.arange(lat.network.n_nodes)
+    size = lat.spacing * (lat.n - 1)
+    j, _ = _misfit(des.target, check.positions, picked, size)
+    rms = float(np.sqrt(2.0 * j)) * size
+    return replace(
+        des,
+        positions=check.positions,
+        misfit_rms=rms,
+        misfit_rel=rms / size,
+        achieved_gaussian_curvature=check.gaussian_curvature,
+        stable=bool(check.stable),
+        bath=check,
+    )
