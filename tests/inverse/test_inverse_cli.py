@@ -58,21 +58,6 @@ def test_curve_target_to_a_design_the_other_commands_accept(tmp_path, capsys):
             "radius_end = 2.2\npitch = 1.5\nturns = 1.0\n[contact]\nfloor = true\n",
             "lattice targets only",
         ),
-        (
-            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
-            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\nfriction = 0.2\n",
-            "frictionless",
-        ),
-        (
-            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
-            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\ngravity = true\n",
-            "contact.branch",
-        ),
-        (
-            'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.02\n[lattice]\nn = 3\n'
-            "spacing = 5.0\namplitude = 1.25\n[contact]\nfloor = true\npath_check = 2\n",
-            "contact.path_check",
-        ),
     ],
 )
 def test_bad_targets_exit_2_with_one_line(tmp_path, capsys, text, fragment):
@@ -98,6 +83,34 @@ def test_lattice_target_resting_on_the_floor_gives_a_design_simulate_runs_alike(
     summary = json.loads((tmp_path / "rest_design_inverse" / "summary.json").read_text())
     assert summary["contact"]["branch"] == "continuous" and summary["contact"]["gravity"]
     assert 'branch = "continuous"' in out.read_text(encoding="utf-8")
+    assert main(["validate", str(out)]) == 0
+
+
+def test_lattice_target_is_designed_and_verified_in_the_bath_by_default(tmp_path, capsys):
+    """Without a [contact] table a lattice target is designed in the bath (self-contact, the
+    floor, the buoyant weight, the lift probe's branch) and verified by simulate's ramp; the
+    line says so, the summary carries the verification and the band, and the design file
+    carries the bath so simulate heats it alike."""
+    target = tmp_path / "bath.toml"
+    target.write_text(
+        'schema_version = 1\nkind = "dome"\n[surface]\ncurvature = 0.1\n[lattice]\nn = 3\n'
+        "spacing = 5.0\namplitude = 1.25\nghost_nodes = 6\n[options]\nmax_iterations = 2\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "bath_design.toml"
+    assert main(["inverse", str(target), "-o", str(out)]) == 0
+    line = capsys.readouterr().out
+    assert "in the bath (self-contact, floor, buoyant weight)" in line
+    assert "simulate's ramp" in line and ("REACHED" in line)
+    summary = json.loads((tmp_path / "bath_design_inverse" / "summary.json").read_text())
+    assert summary["contact"]["gravity"] and summary["contact"]["branch"] == "lowest"
+    verified = summary["verified"]
+    assert verified["verified_by"].startswith("heat_lattice")
+    assert summary["reached"] is verified["reached"]
+    assert summary["band"]["gaussian_curvature_sd_calibration"] > 0
+    assert summary["achieved_gaussian_curvature"] == verified["gaussian_curvature"]
+    text = out.read_text(encoding="utf-8")
+    assert "gravity = true" in text and "floor = true" in text
     assert main(["validate", str(out)]) == 0
 
 
