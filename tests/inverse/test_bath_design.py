@@ -112,3 +112,26 @@ def test_bath_default_and_targets(printed):
     assert c.self_contact and c.floor and c.gravity and c.branch == "lowest"
     assert c.friction == 0 and c.path_check == 1
     assert saddle(0.05).gaussian_curvature < 0
+
+
+@pytest.mark.slow
+def test_robust_design_minimises_the_expected_error_and_says_what_it_gives_up():
+    """The robust choice is the scale of least expected K error over the sigma points, it is
+    verified in the bath like the nominal design, and its nominal give-up is the difference
+    of the two verified errors."""
+    from rotomorph.inverse.environment import design_in_bath
+
+    lat = sinusoidal_lattice(
+        n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
+    )
+    des = design_in_bath(lat, dome(0.1), max_iterations=2, robust=True)
+    choice = des.robust
+    assert choice is not None and des.bath is not None and des.band is not None
+    assert choice.scale == min(choice.expected_error, key=choice.expected_error.get)
+    assert choice.nominal_error_robust == des.bath.error_rel
+    if choice.gives_up is not None:
+        assert choice.gives_up == pytest.approx(
+            choice.nominal_error_robust - choice.nominal_error_nominal
+        )
+    assert des.achieved_gaussian_curvature == des.bath.gaussian_curvature
+    assert set(choice.record()) >= {"strength_scale", "gives_up_nominally"}

@@ -387,20 +387,23 @@ class _Equilibria:
     With ``heated`` (a function of the design returning a state, e.g. the end of
     :func:`~rotomorph.lattice.heat_lattice`'s lowest-energy ramp of its printable rounding),
     a fresh solve starts from that state instead, and falls back to the ramp where it is not
-    a stable equilibrium of the design.
+    a stable equilibrium of the design (from heat_lattice's own perturbed start, above which
+    the floor lies).
     """
 
     def __init__(
         self,
         blend: LatticeBlend,
         seed: int = 0,
-        perturbation: float = DESIGN_PERTURBATION,
+        perturbation: float | None = None,
         retries: int = 3,
         env: Surroundings | None = None,
         heated: Callable[[FloatArray], State] | None = None,
     ) -> None:
         self.blend = blend
         self.heated = heated
+        if perturbation is None:  # on the lowest branch the floor lies under heat_lattice's start
+            perturbation = DESIGN_PERTURBATION if heated is None else HEAT_PERTURBATION
         self.env = env or Surroundings()
         self.seed = seed
         self.perturbation = perturbation
