@@ -37,14 +37,16 @@ import numpy as np
 from rotomorph.analysis.curvature import fit_quadratic_surface
 from rotomorph.design.lattices import Lattice
 from rotomorph.lattice.actuation import ProgramActuation, default_stiffness, get_actuation
-from rotomorph.lattice.heating import HeatingResult, heat_lattice, lattice_buoyancy
+from rotomorph.lattice.heating import HeatingResult, heat_lattice
 from rotomorph.lattice.model import lattice_model
+from rotomorph.solve.loads import Gravity
 
 __all__ = [
     "REACHED_TOLERANCE",
     "VERIFY_STEPS",
     "BathCheck",
     "bath_contact",
+    "bath_kwargs",
     "verify_in_bath",
     "weight_to_bending",
 ]
@@ -160,19 +162,24 @@ class BathCheck:
         }
 
 
-def _actuation(temperature: float) -> ProgramActuation:
+def _actuation(temperature: float, model: Any = None) -> ProgramActuation:
     base = get_actuation("program")
     assert isinstance(base, ProgramActuation)
-    return replace(base, end=float(temperature))
+    return replace(base, end=float(temperature), filament_model=model)
 
 
 def weight_to_bending(
-    lattice: Lattice, characteristic_curvature: float, temperature: float, bath: str
+    lattice: Lattice,
+    characteristic_curvature: float,
+    temperature: float,
+    gravity: Gravity,
+    model: Any = None,
 ) -> float:
     """Γ = w (L/2)² / (B k) of the module docstring (dimensionless): ``w`` the buoyant line
-    weight in ``bath`` at ``temperature`` (°C), ``L`` the lattice size, ``B`` the mean bending
-    stiffness of the heated edges (N mm²), ``k`` the target's √|K| (1/mm)."""
-    act = _actuation(temperature)
+    weight of ``gravity`` (the weight in the bath at ``temperature``, °C), ``L`` the lattice
+    size, ``B`` the mean bending stiffness of the edges heated with the materials ``model``
+    (N mm²), ``k`` the target's √|K| (1/mm)."""
+    act = _actuation(temperature, model)
     stiffness, fm = default_stiffness(act)
     lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
     hot = act.natural(lm, act.end)
@@ -180,16 +187,29 @@ def weight_to_bending(
         np.mean(np.asarray(hot.bending_stiffness1, dtype=float))
         + np.mean(np.asarray(hot.bending_stiffness2, dtype=float))
     )
-    w = float(lattice_buoyancy(lattice, bath=bath)(temperature).line_weight(1)[0])
+    w = float(gravity.line_weight(1)[0])
     half = 0.5 * lattice.spacing * (lattice.n - 1)
     return float(w * half * half / (b * characteristic_curvature))
 
 
-def _heat(lattice: Lattice, contact: Any, temperature: float, steps: int) -> HeatingResult:
+def bath_kwargs(
+    lattice: Lattice, contact: Any, temperature: float, materials: Any = None, *, ramp: bool
+) -> dict[str, Any]:
+    """:func:`~rotomorph.lattice.heat_lattice`'s surroundings as ``simulate`` builds them
+    from the ``[contact]`` table (the weight along the temperature ramp with ``ramp``, else
+    at ``temperature``; the inks of the design's ``materials`` file where it has one)."""
     from rotomorph.simulate.surroundings import lattice_surroundings
 
-    kwargs = lattice_surroundings(contact, lattice, temperature, ramp_in_temperature=True)
-    return heat_lattice(lattice, actuation=_actuation(temperature), steps=steps, **kwargs)
+    return lattice_surroundings(
+        contact, lattice, temperature, ramp_in_temperature=ramp, materials=materials
+    )
+
+
+def _heat(
+    lattice: Lattice, contact: Any, temperature: float, steps: int, model: Any, materials: Any
+) -> HeatingResult:
+    kwargs = bath_kwargs(lattice, contact, temperature, materials, ramp=True)
+    return heat_lattice(lattice, actuation=_actuation(temperature, model), steps=steps, **kwargs)
 
 
 def _overlaps(res: HeatingResult) -> int | None:
@@ -206,6 +226,8 @@ def verify_in_bath(
     steps: int = VERIFY_STEPS,
     tolerance: float = REACHED_TOLERANCE,
     diagnose: bool = True,
+    filament_model: Any = None,
+    materials: Any = None,
 ) -> BathCheck:
     """Heat the printed ``lattice`` as ``rotomorph simulate`` heats its design file with the
     ``[contact]`` table ``contact`` (default :func:`bath_contact`) and judge the end state.
@@ -227,10 +249,14 @@ def verify_in_bath(
     diagnose
         Where the target is not reached under a weight, also heat the design without it
         (``weightless_gaussian_curvature``) and compute Γ (module docstring).
+    filament_model, materials
+        The materials model of the actuation (default the package's calibrated one) and the
+        design's materials file (its inks' densities set the weight), as ``simulate`` takes
+        them from the design file.
     """
     contact = bath_contact() if contact is None else contact
     c0 = time.process_time()
-    res = _heat(lattice, contact, temperature, steps)
+    res = _heat(lattice, contact, temperature, steps, filament_model, materials)
     pos = np.asarray(res.positions[-1])
     fit = fit_quadratic_surface(pos[lattice.branch_indices], flat_tolerance=1e-6)
     k = float(fit.gaussian_curvature)
@@ -265,8 +291,18 @@ def verify_in_bath(
         )
     gamma = weightless = None
     if reasons and diagnose and contact.gravity and k_t is not None:
-        gamma = weight_to_bending(lattice, float(np.sqrt(abs(k_t))), temperature, contact.bath)
-        light = _heat(lattice, contact.model_copy(update={"gravity": False}), temperature, steps)
+        weight = bath_kwargs(lattice, contact, temperature, materials, ramp=False)["gravity"]
+        gamma = weight_to_bending(
+            lattice, float(np.sqrt(abs(k_t))), temperature, weight, filament_model
+        )
+        light = _heat(
+            lattice,
+            contact.model_copy(update={"gravity": False}),
+            temperature,
+            steps,
+            filament_model,
+            materials,
+        )
         lpos = np.asarray(light.positions[-1])
         weightless = float(
             fit_quadratic_surface(

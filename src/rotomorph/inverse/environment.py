@@ -35,7 +35,9 @@ per sigma point); the per-edge pattern is the nominal optimum's.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -49,6 +51,7 @@ from rotomorph.inverse.bath import (
     REACHED_TOLERANCE,
     BathCheck,
     bath_contact,
+    bath_kwargs,
     verify_in_bath,
 )
 from rotomorph.inverse.blend import lattice_blend, with_settings
@@ -208,10 +211,10 @@ def _heated_k(
     )
 
 
-def _program(temperature: float) -> ProgramActuation:
+def _program(temperature: float, model: Any = None) -> ProgramActuation:
     base = get_actuation("program")
     assert isinstance(base, ProgramActuation)
-    return replace(base, end=float(temperature))
+    return replace(base, end=float(temperature), filament_model=model)
 
 
 def _sigma_values(
@@ -279,6 +282,8 @@ def design_in_bath(
     robust: bool = False,
     speed_range: tuple[float, float] | None = MEASURED_SPEEDS,
     speed_resolution: float = 0.05,
+    filament_model: Any = None,
+    materials: Any = None,
     **options: Any,
 ) -> LatticeDesign:
     """Design ``lattice`` for ``target`` in the surroundings ``contact`` declares (a design
@@ -286,6 +291,9 @@ def design_in_bath(
     floor, buoyant weight, the lift probe), verify it by ``simulate``'s ramp and, with
     ``band``, bound its shape by the calibration (module docstring).
 
+    ``filament_model`` and ``materials``: the materials model and the design's materials file
+    (a lab's own inks; as :func:`~rotomorph.inverse.bath.verify_in_bath`); the calibration
+    band is the package calibration's and is left out (None) with another model.
     ``options`` go to :func:`~rotomorph.inverse.lattice.design_lattice` (``max_iterations``,
     ``printability``, ``seed``, ``nodes``, ``callback``). The optimiser is frictionless (lagged
     friction has no adjoint); the verification applies the table's friction and path check.
@@ -294,9 +302,7 @@ def design_in_bath(
     reported as reached.
     """
     contact = bath_contact() if contact is None else contact
-    gravity = None
-    if contact.gravity:
-        gravity = lattice_buoyancy(lattice, bath=contact.bath)(temperature)
+    gravity = bath_kwargs(lattice, contact, temperature, materials, ramp=False).get("gravity")
     floor = bool(contact.floor)
     touch: bool | Contact = False
     if contact.self_contact or floor:
@@ -304,7 +310,7 @@ def design_in_bath(
     des = design_lattice(
         lattice,
         target,
-        actuation=_program(temperature),
+        actuation=_program(temperature, filament_model),
         contact=touch,
         floor=floor,
         gravity=gravity,
@@ -315,18 +321,24 @@ def design_in_bath(
     )
     k_t = target.gaussian_curvature
     scan = k_t is not None and speed_range is not None
-    check = verify_in_bath(
-        des.lattice, k_t, contact, temperature=temperature, tolerance=tolerance, diagnose=not scan
+    verify = partial(
+        verify_in_bath,
+        contact=contact,
+        temperature=temperature,
+        tolerance=tolerance,
+        filament_model=filament_model,
+        materials=materials,
     )
+    check = verify(des.lattice, k_t, diagnose=not scan)
     if scan:
         assert speed_range is not None
-        des, check = _bath_scan(des, check, contact, temperature, tolerance, speed_range,
-                                speed_resolution)  # fmt: skip
+        des, check = _bath_scan(des, check, verify, speed_range, speed_resolution)
     des = _verified(des, check, options.get("nodes", "branch"))
-    if band:
+    calibrated = filament_model is None
+    if band and calibrated:
         des = replace(des, band=design_band(des.lattice, check, contact, temperature=temperature))
-    if robust and k_t is not None and speed_range is not None:
-        des = _robust(des, contact, temperature, tolerance, speed_range, speed_resolution)
+    if robust and calibrated and k_t is not None and speed_range is not None:
+        des = _robust(des, contact, temperature, verify, speed_range, speed_resolution)
     return des
 
 
@@ -337,9 +349,7 @@ BATH_SCALES = (0.84, 0.92, 1.08, 1.18)
 def _bath_scan(
     des: LatticeDesign,
     check: BathCheck,
-    contact: Any,
-    temperature: float,
-    tolerance: float,
+    verify: Callable[..., BathCheck],
     speed_range: tuple[float, float],
     resolution: float,
 ) -> tuple[LatticeDesign, BathCheck]:
@@ -363,10 +373,7 @@ def _bath_scan(
         if any(abs(scale - s) < 1e-9 for s in tried):
             return
         lat = _scaled(des, scale, speed_range, resolution, blend)
-        c = verify_in_bath(
-            lat, k_t, contact, temperature=temperature, tolerance=tolerance, diagnose=False
-        )
-        tried[scale] = (lat, c)
+        tried[scale] = (lat, verify(lat, k_t, diagnose=False))
 
     for scale in BATH_SCALES:
         run(scale)
@@ -379,7 +386,7 @@ def _bath_scan(
     best = min(tried, key=lambda k: rank(tried[k][1]))
     lat, chosen = tried[best]
     if not chosen.reached:  # the measures of an unreached target, on the design returned
-        chosen = verify_in_bath(lat, k_t, contact, temperature=temperature, tolerance=tolerance)
+        chosen = verify(lat, k_t)
     return replace(des, lattice=lat, speeds=np.asarray(lat.edge_speeds, dtype=float)), chosen
 
 
@@ -387,7 +394,7 @@ def _robust(
     des: LatticeDesign,
     contact: Any,
     temperature: float,
-    tolerance: float,
+    verify: Callable[..., BathCheck],
     speed_range: tuple[float, float],
     resolution: float,
 ) -> LatticeDesign:
@@ -409,9 +416,7 @@ def _robust(
     if best == 1.0:
         choice = RobustChoice(1.0, expected, nominal_err, nominal_err, 0.0)
         return replace(des, robust=choice)
-    check = verify_in_bath(
-        printed[best], k_t, contact, temperature=temperature, tolerance=tolerance
-    )
+    check = verify(printed[best], k_t)
     gives = (
         None
         if check.error_rel is None or nominal_err is None
