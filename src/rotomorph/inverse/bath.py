@@ -213,7 +213,9 @@ def _heat(
 
 
 def _overlaps(res: HeatingResult) -> int | None:
-    counts = getattr(res, "stack_overlaps", None)
+    """Interpenetrating layer pairs of the printed stack in the ramp's end state (None: the
+    result carries no admissibility check)."""
+    counts = res.stack_overlaps
     return None if counts is None else int(np.asarray(counts)[-1])
 
 

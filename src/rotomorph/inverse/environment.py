@@ -66,6 +66,7 @@ from rotomorph.inverse.lattice import (
     design_lattice,
 )
 from rotomorph.lattice.actuation import ProgramActuation, default_stiffness, get_actuation
+from rotomorph.lattice.admissibility import lattice_stack
 from rotomorph.lattice.heating import lattice_buoyancy
 from rotomorph.lattice.model import lattice_model
 from rotomorph.rod.state import State
@@ -306,7 +307,12 @@ def design_in_bath(
     floor = bool(contact.floor)
     touch: bool | Contact = False
     if contact.self_contact or floor:
-        touch = Contact(radius=lattice.radius, self_contact=bool(contact.self_contact))
+        # the printed stack's layers touch, one capsule each, as in simulate's ramp
+        touch = Contact(
+            radius=lattice.radius,
+            self_contact=bool(contact.self_contact),
+            stack=lattice_stack(lattice),
+        )
     des = design_lattice(
         lattice,
         target,
