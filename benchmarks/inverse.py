@@ -153,6 +153,7 @@ def bath_case(name: str, pattern: str, target, iterations: int) -> None:  # type
         load_1min=round(load, 2),
         target_metric=des.target_gaussian_curvature,
         achieved_metric=check.gaussian_curvature,
+        optimised_gaussian_curvature=des.optimised_gaussian_curvature,
         gaussian_curvature_error_rel=check.error_rel,
         gaussian_curvature_sd_calibration=band.gaussian_curvature_sd,
         band=band.text(),

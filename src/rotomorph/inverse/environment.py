@@ -325,6 +325,7 @@ def design_in_bath(
         speed_resolution=speed_resolution,
         **options,
     )
+    des = replace(des, optimised_gaussian_curvature=des.achieved_gaussian_curvature)
     k_t = target.gaussian_curvature
     scan = k_t is not None and speed_range is not None
     verify = partial(

@@ -528,6 +528,10 @@ class LatticeDesign:
     robust
         With a robust design: what was chosen over the band and what it gives up nominally
         (:class:`~rotomorph.inverse.environment.RobustChoice`).
+    optimised_gaussian_curvature
+        With ``bath``: K of the optimiser's own verified equilibrium of the design it returned
+        (1/mm²), before ``simulate``'s ramp judged it (the two differ where that ramp lifts the
+        design onto another branch).
     """
 
     lattice: Lattice
@@ -547,6 +551,7 @@ class LatticeDesign:
     bath: BathCheck | None = None
     band: DesignBand | None = None
     robust: RobustChoice | None = None
+    optimised_gaussian_curvature: float | None = None
 
     @property
     def reached(self) -> bool | None:

@@ -344,6 +344,7 @@ def run_inverse(
         "misfit_rel": des.misfit_rel,
         "stable": des.stable,
         "reached": des.bath.reached,
+        "optimised_gaussian_curvature": des.optimised_gaussian_curvature,
         "verified": des.bath.record(),
         "band": None if des.band is None else des.band.record(),
         "robust": None if des.robust is None else des.robust.record(),
