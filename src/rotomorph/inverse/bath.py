@@ -178,7 +178,7 @@ def weight_to_bending(
     """Γ = w (L/2)² / (B k) of the module docstring (dimensionless): ``w`` the buoyant line
     weight of ``gravity`` (the weight in the bath at ``temperature``, °C), ``L`` the lattice
     size, ``B`` the mean bending stiffness of the edges heated with the materials ``model``
-    (N mm²), ``k`` the target's √|K| (1/mm)."""
+    (N mm²), ``k`` the target's ``sqrt(|K|)`` (1/mm)."""
     act = _actuation(temperature, model)
     stiffness, fm = default_stiffness(act)
     lm = lattice_model(lattice, stiffness=stiffness, filament_model=fm)
