@@ -15,6 +15,11 @@ bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
   each ramp temperature, as in ``rotomorph paper``);
   ``lift_off_x`` is the actuation at which a node first rises one filament diameter above
   its printed height (null: never), ``final_lift_mm`` the largest rise at the end;
+* ``contracting-11x11``, ``contracting-21x21``, ``dome-11x11``, ``dome-21x21``: the same
+  lattices at the sizes labs print next (2 321 and 8 841 nodes), 8-step ramps, run only when
+  named (a 21 x 21 ramp takes minutes); every lattice line also gives ``energy_nmm`` (the end
+  state's total energy, to compare end states) and ``s_per_iteration`` (CPU time per Newton
+  iteration, whose growth with ``n_nodes`` is the per-iteration cost's scaling);
 * ``composite-coil``: the composite filament (active fraction 0.5) at ω* = 0.06, heated to
   175 °C with self-contact;
 * ``contracting-sinusoid``: the paper's contracting sinusoid with self-contact;
@@ -24,7 +29,7 @@ bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
   best of two alternating runs each after a warm-up run.
 
 Run: ``python benchmarks/contact.py [--quick] [--repeat K] [CASE ...]`` (``--quick``: 4-step
-ramps; cases by name, default all). The lattices present their printed stack to contact (one
+ramps; cases by name, default all but the large lattices). The lattices present their printed stack to contact (one
 capsule per layer, three layers).
 """
 
@@ -74,8 +79,13 @@ def _bound(res):  # type: ignore[no-untyped-def]
     return StackedContact(res.contact, net, up)
 
 
-def lattice_case(pattern: str, steps: int, repeat: int = 1) -> dict:
-    lat = sinusoidal_lattice(pattern=pattern)
+#: the large lattices (branch nodes per side), run only when named; 8-step ramps
+LARGE = (11, 21)
+LARGE_STEPS = 8
+
+
+def lattice_case(pattern: str, steps: int, repeat: int = 1, n: int = 5) -> dict:
+    lat = sinusoidal_lattice(n=n, pattern=pattern)
     cpus, walls = [], []
     for _ in range(repeat):
         c0, t0 = time.process_time(), time.perf_counter()
@@ -84,7 +94,7 @@ def lattice_case(pattern: str, steps: int, repeat: int = 1) -> dict:
         cpus.append(time.process_time() - c0)
     wall, cpu = float(np.median(walls)), float(np.median(cpus))
     row = {
-        "case": f"{pattern}-5x5",
+        "case": f"{pattern}-{n}x{n}",
         "n_nodes": int(lat.network.n_nodes),
         "steps": steps,
         "floor": True,
@@ -103,7 +113,9 @@ def lattice_case(pattern: str, steps: int, repeat: int = 1) -> dict:
         "contact_distance_ratio": _contact_ratio(_bound(res), res.states[-1]),
         "area_ratio": round(float(res.area_ratio[-1]), 4),
         "gaussian_sign": int(res.gaussian_sign[-1]),
+        "energy_nmm": float(res.energy[-1]),
         "max_halvings": int(res.halvings.max()),
+        "s_per_iteration": round(cpu / max(int(res.total_iterations), 1), 5),
     }
     row["lift_off_x"] = res.first_lift_off()
     row["final_lift_mm"] = round(float(res.floor_lift[-1]), 4)  # type: ignore[index]
@@ -221,6 +233,10 @@ def main(quick: bool = False, only: tuple[str, ...] = (), repeat: int = 1) -> No
     for pattern in ("contracting", "dome", "saddle"):
         if wanted(f"{pattern}-5x5"):
             _emit(lattice_case(pattern, steps, repeat))
+    for n in LARGE:
+        for pattern in ("contracting", "dome"):
+            if f"{pattern}-{n}x{n}" in only:
+                _emit(lattice_case(pattern, 4 if quick else LARGE_STEPS, repeat, n))
     if wanted("composite-coil"):
         coil = Filament(
             speed=3.0,
