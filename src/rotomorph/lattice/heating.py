@@ -865,11 +865,12 @@ SEARCH_CERTIFY = False
 #: barrier has no curvature: Newton steps run into them, the line search cuts them to a few
 #: per cent of the collision-free bound, the next whole step cleans up. The softer barrier
 #: lets those steps close most of each gap; the certified solve with the ramp's barrier then
-#: starts with the pairs inside its activation distance, where its Hessian sees them. Measured
-#: on the contracting 11 x 11 ramp (8 steps): the two orientations' settling 242 + 204 ->
-#: (55 + 107) + (70 + 24) iterations, the same end state; on the 5 x 5 ramps (16 steps) the
-#: dome 166 -> 186 and the saddle 259 -> 274, the same end states (0.1: 177, 268 and 395 on
-#: the 11 x 11).
+#: starts with the pairs inside its activation distance, where its Hessian sees them. With
+#: :data:`SEARCH_RTOL`: the contracting 11 x 11 ramp (8 steps) 534 -> 339 iterations, the dome
+#: 600 -> 387, the 5 x 5 saddle (16 steps) 536 -> 355, the 5 x 5 dome 214 -> 217; the same end
+#: states but the contracting 11 x 11's, a neighbouring jam 3.4e-6 lower in energy
+#: (``docs/contact.md``, *Lattices of 11 x 11 and 21 x 21 cells*; 1/10 instead of 1/100 saved
+#: less).
 SETTLE_SOFTENING: float | None = 0.01
 
 
@@ -913,7 +914,7 @@ def _lift_probe(
     orientations), toppled as a rigid body into the pose it rests in under its weight
     (:func:`~rotomorph.lattice.resting.resting_rotation`; a saddle laid on its two low corners
     rocks over), where its elastic equilibrium under its weight is solved with the ramp's
-    contact model. It returns ``(best lifted result or None, its energy minus the resting
+    contact model (from a first settling with a softer barrier, :data:`SETTLE_SOFTENING`). It returns ``(best lifted result or None, its energy minus the resting
     one or None, Newton iterations spent)``. A lifted
     result is returned only if it is certified stable, admissible (no two layers of the
     printed stack interpenetrate: :mod:`rotomorph.lattice.admissibility`), lower in total
