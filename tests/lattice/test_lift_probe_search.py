@@ -69,7 +69,7 @@ def test_search_solves_are_searches_and_reported_states_are_certified(recorded):
         assert c.stiffness_scale == pytest.approx(heating.SETTLE_SOFTENING * ramp_scale)
         assert o.rtol == RAMP_OPTIONS.rtol and not o.check_stability
         # the next solve starts where it ended, with the ramp's barrier, certified
-        _, o2, c2, start, res2 = calls[k + 1]
+        _, o2, c2, start, _ = calls[k + 1]
         assert c2.stiffness_scale == ramp_scale and o2.check_stability
         assert np.array_equal(start.positions, res.state.positions)
     assert all(result.stable)

@@ -914,13 +914,13 @@ def _lift_probe(
     orientations), toppled as a rigid body into the pose it rests in under its weight
     (:func:`~rotomorph.lattice.resting.resting_rotation`; a saddle laid on its two low corners
     rocks over), where its elastic equilibrium under its weight is solved with the ramp's
-    contact model (from a first settling with a softer barrier, :data:`SETTLE_SOFTENING`). It returns ``(best lifted result or None, its energy minus the resting
-    one or None, Newton iterations spent)``. A lifted
-    result is returned only if it is certified stable, admissible (no two layers of the
-    printed stack interpenetrate: :mod:`rotomorph.lattice.admissibility`), lower in total
-    energy (elastic + weight + barrier) and actually off the floor. A lift found inside a
-    halved or path-check sub-step is recorded in the row of the step it leads to
-    (``_gaps_per_step``).
+    contact model (from a first settling with a softer barrier, :data:`SETTLE_SOFTENING`).
+    It returns ``(best lifted result or None, its energy minus the resting one or None,
+    Newton iterations spent)``. A lifted result is returned only if it is certified stable,
+    admissible (no two layers of the printed stack interpenetrate:
+    :mod:`rotomorph.lattice.admissibility`), lower in total energy (elastic + weight +
+    barrier) and actually off the floor. A lift found inside a halved or path-check sub-step
+    is recorded in the row of the step it leads to (``_gaps_per_step``).
 
     With friction the comparison is between potential energies (elastic + weight + barrier):
     lagged friction is dissipation, not a potential, so it is left out of both. The lifted
