@@ -29,8 +29,8 @@ bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
   best of two alternating runs each after a warm-up run.
 
 Run: ``python benchmarks/contact.py [--quick] [--repeat K] [CASE ...]`` (``--quick``: 4-step
-ramps; cases by name, default all but the large lattices). The lattices present their printed stack to contact (one
-capsule per layer, three layers).
+ramps; cases by name, default all but the large lattices). The lattices present their printed
+stack to contact (one capsule per layer, three layers).
 """
 
 from __future__ import annotations

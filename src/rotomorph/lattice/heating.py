@@ -874,6 +874,34 @@ SEARCH_CERTIFY = False
 SETTLE_SOFTENING: float | None = 0.01
 
 
+def _settle_softened(
+    model: Model,
+    supports: Supports,
+    loads: Loads,
+    start: State,
+    options: NewtonOptions,
+    contact: Contact,
+) -> tuple[State, int]:
+    """The first, softened settling of a lifted candidate on the floor
+    (:data:`SETTLE_SOFTENING`): the state it reaches and the Newton iterations spent. It is
+    only a search: where it runs out of iterations its last iterate is kept, where it fails
+    otherwise the candidate settles from ``start`` with the ramp's barrier alone."""
+    try:
+        soft = solve_static(
+            model, supports, loads, initial=start,
+            options=replace(options, check_stability=False),
+            contact=_softened(contact, SETTLE_SOFTENING),  # type: ignore[arg-type]
+        )  # fmt: skip
+    except (ConvergenceError, InfeasibleContactError) as err:
+        result = getattr(err, "result", None)
+        spent = int(getattr(result, "iterations", 0))
+        last = getattr(err, "state", None)
+        if getattr(result, "status", None) is Status.MAX_ITERATIONS and last is not None:
+            return last, spent
+        return start, spent
+    return soft.state, soft.iterations
+
+
 def _softened(settings: Contact, factor: float) -> Contact:
     """``settings`` with the barrier stiffness scaled by ``factor``."""
     return replace(
@@ -974,13 +1002,8 @@ def _lift_probe(
         start = _laid_on(free.state, floor, gap_floor, flip, weight)
         try:
             if SETTLE_SOFTENING is not None:
-                soft = solve_static(
-                    model, supports, loads, initial=start,
-                    options=replace(options, check_stability=False),
-                    contact=_softened(on_floor, SETTLE_SOFTENING),
-                )  # fmt: skip
-                spent += soft.iterations
-                start = soft.state
+                start, its = _settle_softened(model, supports, loads, start, options, on_floor)
+                spent += its
             trial = solve_static(
                 model, supports, loads, initial=start, options=options, contact=on_floor
             )
