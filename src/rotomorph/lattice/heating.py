@@ -950,7 +950,7 @@ def _lift_probe(
     orientations), toppled as a rigid body into the pose it rests in under its weight
     (:func:`~rotomorph.lattice.resting.resting_rotation`; a saddle laid on its two low corners
     rocks over), where its elastic equilibrium under its weight is solved with the ramp's
-    contact model (from a first settling with a softer barrier, :data:`SETTLE_SOFTENING`).
+    contact model (where :data:`SETTLE_SOFTENING` is set, after a softer first settling).
     It returns ``(best lifted result or None, its energy minus the resting one or None,
     Newton iterations spent)``. A lifted result is returned only if it is certified stable,
     admissible (no two layers of the printed stack interpenetrate:
