@@ -1064,7 +1064,11 @@ def _settle_weightless(
     Newton iterations spent: a solve that runs out of iterations is continued from its last
     iterate, up to :data:`SEARCH_SOLVES` solves."""
     spent = 0
-    options = replace(options, rtol=max(options.rtol, SEARCH_RTOL), check_stability=SEARCH_CERTIFY)
+    options = replace(
+        options,
+        rtol=max(options.rtol, SEARCH_RTOL),
+        check_stability=options.check_stability and SEARCH_CERTIFY,
+    )
     for _ in range(SEARCH_SOLVES):
         try:
             free = solve_static(
