@@ -44,7 +44,9 @@ def test_a_stacked_contracting_lattice_jams_flat_with_its_layers_apart():
     assert res.contact is not None and res.contact.stack.count == 3
     assert res.stack_overlaps is not None and not res.stack_overlaps.any()
     assert all(res.physical)
-    assert res.min_clearance.min() >= 1.0 and res.contacts_active[-1] > 0
+    # the barrier is infinite 1 % of the diameter inside touching (Contact.offset's default,
+    # the activation distance) and pressed contacts settle within a small part of that
+    assert res.min_clearance.min() >= 0.995 and res.contacts_active[-1] > 0
     # the floor lies under the bottom layer of the (perturbed) start: the stack rests on it
     assert res.contact.floor is not None
     start = res.states[0].positions[:, 2].min() - 0.6 - 1.005 * lat.radius
