@@ -443,8 +443,8 @@ def test_readme_commands_run_verbatim(block, tmp_path, require_tool):
     for cmd in block.commands:
         if cmd.startswith(SKIP):
             continue
-        proc = subprocess.run(
-            ["bash", "-c", cmd], cwd=repo, env=env, capture_output=True, text=True, timeout=900
+        proc = subprocess.run(  # a guard against hangs: the full report is ~13 min of CPU
+            ["bash", "-c", cmd], cwd=repo, env=env, capture_output=True, text=True, timeout=2400
         )
         assert proc.returncode == 0, f"README command failed: {cmd}\n{proc.stderr[-3000:]}"
         ran += 1
