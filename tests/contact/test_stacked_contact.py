@@ -47,10 +47,11 @@ def stacked_pair(rng, request):  # type: ignore[no-untyped-def]
     net = _crossing(3.0)
     edges = net.edges
     up = np.tile([0.0, 0.0, 1.0], (net.n_edges, 1))
-    floor = (Floor(height=-0.6 - R - 0.03),) if request.param else ()
+    # the barrier acts from touching (its zone ends there) to the offset inside it
+    floor = (Floor(height=-0.6 - R + 0.025),) if request.param else ()
     contact = Contact(radius=R, stack=STACK, activation_distance=0.05, obstacles=floor)
     pot = StackedContact(contact, net, up, force_scale=1e-3)
-    x = _crossing(1.8 + 0.025).nodes + 0.003 * rng.standard_normal((net.n_nodes, 3))
+    x = _crossing(1.8 - 0.025).nodes + 0.003 * rng.standard_normal((net.n_nodes, 3))
     t0 = unit(x[edges[:, 1]] - x[edges[:, 0]])
     d1 = unit(up - np.einsum("ij,ij->i", up, t0)[:, None] * t0)  # near the sheet normal
     theta = 0.01 * rng.standard_normal(net.n_edges)

@@ -35,4 +35,6 @@ def test_every_counted_state_keeps_its_layers_apart(pattern: str) -> None:
     assert res.stack_overlaps is not None
     assert res.stack_overlaps.tolist() == [0] * len(res.parameter)
     assert all(res.physical), res.stable
-    assert float(res.min_clearance.min()) >= 1.0
+    # the contact barrier ends at touching and is infinite 1 % of the diameter inside it
+    # (Contact.offset's default): pressed stacks settle within a small part of that
+    assert float(res.min_clearance.min()) >= 0.995

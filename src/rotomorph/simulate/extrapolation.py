@@ -1,7 +1,7 @@
 """Whether a simulation's settings lie outside the range its materials law was calibrated on.
 
 The calibrated range (:func:`rotomorph.materials.calibrated_range.calibrated_range`) is where
-the paper's filament measurements lie: print speeds 0.25-3 mm/s at ω* = 0, |ω*| up to 2 at
+the paper's filament measurements lie: print speeds 0.25-3 mm/s at ω* = 0, ω* up to ±2 at
 3 mm/s, 175 °C, R = 0.3 mm, half or all of the section active, the paper's two inks. A run
 outside it extrapolates the fitted laws; :func:`run_extrapolation` says why, and
 :func:`~rotomorph.simulate.run_data.describe_run` puts it into every output of ``simulate``
