@@ -55,6 +55,8 @@ class CalibratedRange:
         Heating temperature of all series (°C).
     radius
         Filament radius (mm).
+    materials
+        The (active, passive) inks the calibration is for.
     """
 
     speed: tuple[float, float]
@@ -62,6 +64,7 @@ class CalibratedRange:
     rotation_speed: float
     temperature: float
     radius: float
+    materials: tuple[str, str] = CALIBRATED_MATERIALS
 
     def record(self) -> dict[str, Any]:
         """JSON-able form."""
@@ -124,10 +127,10 @@ class CalibratedRange:
                 f"active fraction {active_fraction:g}: the calibration has 0.5 (Janus) and 1 "
                 "(pure LCE)"
             )
-        if materials is not None and tuple(materials) != CALIBRATED_MATERIALS:
+        if materials is not None and tuple(materials) != self.materials:
             out.append(
                 f"materials {materials[0]}/{materials[1]}: the calibration is for "
-                f"{CALIBRATED_MATERIALS[0]}/{CALIBRATED_MATERIALS[1]} (its band does not apply)"
+                f"{self.materials[0]}/{self.materials[1]} (its band does not apply)"
             )
         return out
 
