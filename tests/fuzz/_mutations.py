@@ -11,6 +11,7 @@ import tracemalloc
 from collections.abc import Callable
 from typing import Any
 
+import pytest
 import tomli_w
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
@@ -118,6 +119,19 @@ def cases_of(module: str) -> dict[str, int]:
     """Cases counted for the tests of ``module``, by test name."""
     prefix = module + "."
     return {k[len(prefix) :]: v for k, v in CASES.items() if k.startswith(prefix)}
+
+
+def assert_cases_ran(module: str, names: dict[str, Any], at_least: int) -> None:
+    """The fuzz tests of ``module`` (its ``test_`` names, the case-count check itself and an
+    examples check left out) ran ``>= at_least`` cases in all; skipped when only some ran."""
+    mine = cases_of(module)
+    fuzzers = {n for n in names if n.startswith("test_")} - {
+        "test_zz_at_least_2000_cases_ran",
+        "test_examples_are_valid",
+    }
+    if set(mine) != fuzzers:
+        pytest.skip("only some fuzz tests were selected")
+    assert sum(mine.values()) >= at_least, mine
 
 
 def checked(call: Callable[[], Any], documented: tuple[type[BaseException], ...]) -> Any:
