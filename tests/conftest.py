@@ -50,14 +50,6 @@ def require_tool():
     return _require
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Slow tests first (a stable sort): on the xdist workers the long ones start while every
-    worker is free and the short ones fill in behind them, instead of one long test starting
-    last and running alone."""
-    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
-
-
 #: Tests that share one heavy computation, kept on one worker one after the other (the
 #: second reads the first's cached result instead of waiting for it on another worker): the
 #: README's ``rotomorph paper`` and the README table test compute the same report.
@@ -78,6 +70,24 @@ def xdist_scope(nodeid: str) -> str:
     if nodeid.startswith(EACH_ITS_OWN):
         return nodeid
     return nodeid.split("::", 1)[0]
+
+
+def start_rank(item: pytest.Item) -> int:
+    """When a test starts (stable sort, lower first): the shared report unit
+    (:data:`SHARED_WORK`, the longest unit by far: the full report, about half the suite's
+    CPU) before everything, so its worker is never the last to finish; then the other slow
+    tests while every worker is free; the short ones fill in behind them."""
+    if item.nodeid in SHARED_WORK:
+        return 0
+    return 1 if item.get_closest_marker("slow") is not None else 2
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Tests in :func:`start_rank` order: on the xdist workers the long ones start while every
+    worker is free and the short ones fill in behind them, instead of one long test starting
+    last and running alone."""
+    items.sort(key=start_rank)
 
 
 @pytest.hookimpl(tryfirst=True)

@@ -555,3 +555,33 @@ def test_the_shared_report_units_name_real_tests():
         function, _, param = name.partition("[")
         assert f"def {function}(" in (ROOT / path).read_text(encoding="utf-8"), nodeid
         assert not param or param.rstrip("]") in ids, nodeid
+
+
+def test_the_shared_report_unit_starts_first():
+    """The report unit is the suite's longest: it is sorted before every other test (slow or
+    not), so the scheduler hands it out first and its worker is not the last to finish."""
+    path = ROOT / "tests" / "conftest.py"
+    spec = importlib.util.spec_from_file_location("tests_root_conftest_order", path)
+    assert spec is not None and spec.loader is not None
+    root_conftest = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(root_conftest)
+
+    class Item:
+        def __init__(self, nodeid: str, slow: bool) -> None:
+            self.nodeid, self.slow = nodeid, slow
+
+        def get_closest_marker(self, name: str) -> object:
+            return object() if name == "slow" and self.slow else None
+
+    shared = list(root_conftest.SHARED_WORK)
+    items = [Item("tests/a.py::fast", False), Item("tests/b.py::slow", True)]
+    items += [Item(n, True) for n in reversed(shared)] + [Item("tests/z.py::slow", True)]
+    items.sort(key=root_conftest.start_rank)
+    assert [i.nodeid for i in items[: len(shared)]] == list(reversed(shared))
+    assert [i.nodeid for i in items[len(shared) :]] == [
+        "tests/b.py::slow",
+        "tests/z.py::slow",
+        "tests/a.py::fast",
+    ]
+    # the scheduler's first unit is the report's
+    assert root_conftest.xdist_scope(items[0].nodeid) == "paper-report"
