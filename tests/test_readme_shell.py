@@ -574,14 +574,20 @@ def test_the_shared_report_unit_starts_first():
             return object() if name == "slow" and self.slow else None
 
     shared = list(root_conftest.SHARED_WORK)
-    items = [Item("tests/a.py::fast", False), Item("tests/b.py::slow", True)]
+    (beside,) = root_conftest.BESIDE_THE_REPORT
+    items = [Item("tests/a.py::fast", False), Item(beside, True), Item("tests/b.py::slow", True)]
     items += [Item(n, True) for n in reversed(shared)] + [Item("tests/z.py::slow", True)]
     items.sort(key=root_conftest.start_rank)
     assert [i.nodeid for i in items[: len(shared)]] == list(reversed(shared))
     assert [i.nodeid for i in items[len(shared) :]] == [
+        beside,
         "tests/b.py::slow",
         "tests/z.py::slow",
         "tests/a.py::fast",
     ]
-    # the scheduler's first unit is the report's
+    # the scheduler's first unit is the report's, its second the test computing the report's
+    # Fig. 4 sweeps beside it; the latter names a real test
     assert root_conftest.xdist_scope(items[0].nodeid) == "paper-report"
+    assert root_conftest.xdist_scope(beside) != "paper-report"
+    path, name = beside.split("::", 1)
+    assert f"def {name}(" in (ROOT / path).read_text(encoding="utf-8"), beside

@@ -40,7 +40,14 @@ from rotomorph.lattice.published import (
 )
 from rotomorph.simulate.cache import disk_cached
 
-__all__ = ["PublishedSection", "published_section", "records", "shapes_figure", "sweep_figure"]
+__all__ = [
+    "PublishedSection",
+    "published_section",
+    "records",
+    "report_sweeps",
+    "shapes_figure",
+    "sweep_figure",
+]
 
 #: Stretch spacing and largest stretch magnitude of the report's sweeps (quick mode: a short
 #: smoke run of 11 values; coarser steps cost more, not less: each jump is a long Newton path).
@@ -75,6 +82,14 @@ def _sweep(step: float, end: float, weightless: bool) -> PublishedSweep:
             lambda: published_sweep(step, end, floor=False, friction=0.0, acceleration=0.0),
         )
     return disk_cached("published_sweep", key, lambda: published_sweep(step, end))
+
+
+def report_sweeps(*, quick: bool) -> tuple[PublishedSweep, PublishedSweep]:
+    """The section's two sweeps on its grid (:data:`GRID`): on the floor as the authors ran it,
+    and weightless and free; each cached on disk (:func:`rotomorph.simulate.cache.disk_cached`),
+    so a process that computed them before (or is computing them now) supplies them."""
+    step, end = GRID[quick]
+    return _sweep(step, end, weightless=False), _sweep(step, end, weightless=True)
 
 
 def not_physical(sweep: PublishedSweep, k: int) -> str | None:
@@ -309,9 +324,7 @@ def _admissibility_lines(floor: PublishedSweep, free: PublishedSweep) -> list[st
 def published_section(folder: Path, figs: Path | None, *, quick: bool) -> PublishedSection:
     """Sweep the authors' set-up both ways, write the figures and the JSON record, and return
     the section's Markdown (module docstring)."""
-    step, end = GRID[quick]
-    floor = _sweep(step, end, weightless=False)
-    free = _sweep(step, end, weightless=True)
+    floor, free = report_sweeps(quick=quick)
     paths: list[Path] = []
     if figs is not None:
         from rotomorph.plot.figure import save_figure
