@@ -81,17 +81,29 @@ BESIDE_THE_REPORT = (
 )
 
 
+#: Test files that read the report's filament rows (``validate_filaments``, cached once for
+#: the run: the calibrations and the self-contact sinusoids, which the report unit computes
+#: first): started after the other slow tests, when the report unit has them cached, instead of
+#: waiting on its lock (or computing them while the report unit waits).
+AFTER_THE_REPORTS_FILAMENTS = (
+    "tests/cli/test_paper.py::",
+    "tests/simulate/test_simulate_matches_report.py::",
+)
+
+
 def start_rank(item: pytest.Item) -> int:
     """When a test starts (stable sort, lower first): the shared report unit
     (:data:`SHARED_WORK`, the longest unit by far) before everything, so its worker is never
     the last to finish; then :data:`BESIDE_THE_REPORT`, which the scheduler hands to the
-    other worker; then the other slow tests while every worker is free; the short ones fill
-    in behind them."""
+    other worker; then the other slow tests while every worker is free, then
+    :data:`AFTER_THE_REPORTS_FILAMENTS`; the short ones fill in behind them."""
     if item.nodeid in SHARED_WORK:
         return 0
     if item.nodeid in BESIDE_THE_REPORT:
         return 1
-    return 2 if item.get_closest_marker("slow") is not None else 3
+    if item.nodeid.startswith(AFTER_THE_REPORTS_FILAMENTS):
+        return 3
+    return 2 if item.get_closest_marker("slow") is not None else 4
 
 
 @pytest.hookimpl(tryfirst=True)

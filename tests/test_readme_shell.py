@@ -575,7 +575,9 @@ def test_the_shared_report_unit_starts_first():
 
     shared = list(root_conftest.SHARED_WORK)
     (beside,) = root_conftest.BESIDE_THE_REPORT
-    items = [Item("tests/a.py::fast", False), Item(beside, True), Item("tests/b.py::slow", True)]
+    after = root_conftest.AFTER_THE_REPORTS_FILAMENTS[0] + "test_x"
+    items = [Item("tests/a.py::fast", False), Item(beside, True), Item(after, True)]
+    items += [Item("tests/b.py::slow", True)]
     items += [Item(n, True) for n in reversed(shared)] + [Item("tests/z.py::slow", True)]
     items.sort(key=root_conftest.start_rank)
     assert [i.nodeid for i in items[: len(shared)]] == list(reversed(shared))
@@ -583,8 +585,11 @@ def test_the_shared_report_unit_starts_first():
         beside,
         "tests/b.py::slow",
         "tests/z.py::slow",
+        after,
         "tests/a.py::fast",
     ]
+    for prefix in root_conftest.AFTER_THE_REPORTS_FILAMENTS:
+        assert (ROOT / prefix.split("::")[0]).is_file(), prefix
     # the scheduler's first unit is the report's, its second the test computing the report's
     # Fig. 4 sweeps beside it; the latter names a real test
     assert root_conftest.xdist_scope(items[0].nodeid) == "paper-report"
