@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from typing import Any
 
 import pytest
 
@@ -72,12 +73,14 @@ def xdist_scope(nodeid: str) -> str:
     return nodeid.split("::", 1)[0]
 
 
-#: Tests that compute, into the run's shared result cache, a part of the report that the
-#: report unit needs last (the authors' Fig. 4 sweeps, about 40 % of the report's CPU): started
-#: second, on the other worker, beside the report unit, which then reads them.
+#: Test files (in this order) that compute, into the run's shared result cache, parts of the
+#: report the report unit needs later: the authors' Fig. 4 sweeps (about a third of the
+#: report's CPU, needed last) and the counted contact-resolved lattice ramps at the finer
+#: resolution. Started second and third, on the other worker, beside the report unit, which
+#: then reads them.
 BESIDE_THE_REPORT = (
-    "tests/simulate/test_report_published_full.py::"
-    "test_full_sweeps_reach_both_ends_with_the_documented_onsets",
+    "tests/simulate/test_report_published_full.py::",
+    "tests/lattice/test_lattices_as_printed.py::",
 )
 
 
@@ -91,19 +94,20 @@ AFTER_THE_REPORTS_FILAMENTS = (
 )
 
 
-def start_rank(item: pytest.Item) -> int:
+def start_rank(item: pytest.Item) -> tuple[int, int]:
     """When a test starts (stable sort, lower first): the shared report unit
     (:data:`SHARED_WORK`, the longest unit by far) before everything, so its worker is never
     the last to finish; then :data:`BESIDE_THE_REPORT`, which the scheduler hands to the
     other worker; then the other slow tests while every worker is free, then
     :data:`AFTER_THE_REPORTS_FILAMENTS`; the short ones fill in behind them."""
     if item.nodeid in SHARED_WORK:
-        return 0
-    if item.nodeid in BESIDE_THE_REPORT:
-        return 1
+        return 0, 0
+    for k, prefix in enumerate(BESIDE_THE_REPORT):
+        if item.nodeid.startswith(prefix):
+            return 1, k
     if item.nodeid.startswith(AFTER_THE_REPORTS_FILAMENTS):
-        return 3
-    return 2 if item.get_closest_marker("slow") is not None else 4
+        return 3, 0
+    return (2, 0) if item.get_closest_marker("slow") is not None else (4, 0)
 
 
 @pytest.hookimpl(tryfirst=True)
@@ -127,6 +131,21 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
     class SuiteScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
             return xdist_scope(nodeid)
+
+        def _reschedule(self, node: Any) -> None:
+            # a node gets its next unit when it is down to its last test (a worker runs a
+            # test once it knows the next one), not while it still holds two or more:
+            # xdist's default of two pending tests queues a whole unit behind the report's
+            # long unit, and a unit behind a worker's last long test, that the other worker
+            # could have run
+            if node.shutting_down:
+                return
+            if not self.workqueue:
+                node.shutdown()
+                return
+            if self._pending_of(self.assigned_work[node]) > 1:
+                return
+            self._assign_work_unit(node)
 
     config.option.loadscopereorder = False  # keep the collection order: slow units first
     return SuiteScheduling(config, log)  # type: ignore[arg-type]

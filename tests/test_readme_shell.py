@@ -574,25 +574,24 @@ def test_the_shared_report_unit_starts_first():
             return object() if name == "slow" and self.slow else None
 
     shared = list(root_conftest.SHARED_WORK)
-    (beside,) = root_conftest.BESIDE_THE_REPORT
+    beside = [p + "test_x" for p in root_conftest.BESIDE_THE_REPORT]
     after = root_conftest.AFTER_THE_REPORTS_FILAMENTS[0] + "test_x"
-    items = [Item("tests/a.py::fast", False), Item(beside, True), Item(after, True)]
-    items += [Item("tests/b.py::slow", True)]
+    items = [Item("tests/a.py::fast", False), Item(beside[1], True), Item(after, True)]
+    items += [Item("tests/b.py::slow", True), Item(beside[0], True)]
     items += [Item(n, True) for n in reversed(shared)] + [Item("tests/z.py::slow", True)]
     items.sort(key=root_conftest.start_rank)
     assert [i.nodeid for i in items[: len(shared)]] == list(reversed(shared))
     assert [i.nodeid for i in items[len(shared) :]] == [
-        beside,
+        *beside,
         "tests/b.py::slow",
         "tests/z.py::slow",
         after,
         "tests/a.py::fast",
     ]
+    # the scheduler's first unit is the report's, then those computing parts of it beside it
+    assert root_conftest.xdist_scope(items[0].nodeid) == "paper-report"
+    assert all(root_conftest.xdist_scope(b) != "paper-report" for b in beside)
+    for prefix in root_conftest.BESIDE_THE_REPORT:
+        assert (ROOT / prefix.split("::")[0]).is_file(), prefix
     for prefix in root_conftest.AFTER_THE_REPORTS_FILAMENTS:
         assert (ROOT / prefix.split("::")[0]).is_file(), prefix
-    # the scheduler's first unit is the report's, its second the test computing the report's
-    # Fig. 4 sweeps beside it; the latter names a real test
-    assert root_conftest.xdist_scope(items[0].nodeid) == "paper-report"
-    assert root_conftest.xdist_scope(beside) != "paper-report"
-    path, name = beside.split("::", 1)
-    assert f"def {name}(" in (ROOT / path).read_text(encoding="utf-8"), beside
