@@ -92,13 +92,16 @@ def crowded_ticks(axis: Axis, renderer: object, gap: float = TICK_GAP_PX) -> boo
 def legible_ticks(fig: Figure, *, max_rounds: int = 6) -> Figure:
     """Draw ``fig`` and thin the major ticks of every linear 2-D axis whose tick labels touch
     (:func:`crowded_ticks`), one tick fewer per round, until none touch. Returns ``fig``."""
+    axes = _tick_axes(fig)
+    if not axes:  # only 3-D panels or fixed ticks: nothing to measure, no draw spent
+        return fig
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     literal_text(fig)
     bins: dict[Axis, int] = {}  # the bin counts set here, per axis
     for _ in range(max_rounds):
-        canvas.draw()
+        fig.draw_without_rendering()  # places the ticks; nothing is rasterised
         renderer = canvas.get_renderer()
-        crowded = [a for a in _tick_axes(fig) if crowded_ticks(a, renderer)]
+        crowded = [a for a in axes if crowded_ticks(a, renderer)]
         if not crowded:
             break
         for axis in crowded:
