@@ -1,5 +1,6 @@
 """A sweep labels a filament's shape as ``summary.json`` does: a gently bent arc (a Janus
-filament bent through less than a radian) is no coil, and the phase diagram still shows it."""
+filament bent through less than a radian) is no coil, a twisted rod keeps its label (it claims
+no helix), and the phase diagram still shows unlabelled points."""
 
 from __future__ import annotations
 
@@ -34,6 +35,22 @@ def test_a_gently_bent_arc_is_not_called_a_coil(length, label) -> None:
     row = filament_metrics(sim, {})
     assert row["morphology"] == label
     assert row["helix_turns"] == pytest.approx(sim.helix.turns)  # the fit is still reported
+
+
+def test_a_twisted_rod_keeps_its_label_without_a_helix() -> None:
+    """A rotated pure-LCE-like filament printed slowly at high rotation barely bends: the
+    material twist labels it a twisted rod, for which no helix is fitted."""
+    f = Filament(
+        speed=0.25,
+        rotation_number=1.12,
+        active_fraction=0.5,
+        spacing=0.5,
+        segments=[{"kind": "line", "length": 20.0}],  # type: ignore[list-item]
+    )
+    sim = simulate_filament(f.to_program(), steps=4)
+    assert sim.morphology.value == "twisted rod" and sim.helix is None
+    assert shape_label(sim) == "twisted rod"
+    assert filament_metrics(sim, {})["morphology"] == "twisted rod"
 
 
 def test_the_phase_diagram_shows_unlabelled_points() -> None:

@@ -246,11 +246,12 @@ def _helix_rejection(sim: FilamentSimulation) -> str | None:
 
 def shape_label(sim: FilamentSimulation) -> str | None:
     """The morphology label of a simulated filament's final shape where it describes the shape:
-    ``"straight"``, or a label whose fitted helix fits (rms residual below
+    ``"straight"`` and ``"twisted rod"`` (labels of a straight centre line, which claim no
+    helix), or ``"helix"``/``"coil"`` where the fitted helix fits (rms residual below
     :data:`HELIX_FIT_RTOL` of its radius, at least :data:`HELIX_MIN_TURNS` turns); ``None``
     otherwise (a gently bent arc is not a coil, a sinusoid not a helix). ``summary.json`` and
     sweep tables both give this."""
-    if sim.morphology.value == "straight" or _helix_rejection(sim) is None:
+    if sim.morphology.value in ("straight", "twisted rod") or _helix_rejection(sim) is None:
         return str(sim.morphology.value)
     return None
 
