@@ -60,10 +60,19 @@ def _stable(res) -> bool | None:  # type: ignore[no-untyped-def]
 
 
 def _contact_ratio(pot, where) -> float | None:  # type: ignore[no-untyped-def]
-    """Median ``d / (r_a + r_b)`` of the pairs (and floor points) carrying force at ``where``."""
-    d, dmin = pot.distances(where)
-    active = d < dmin + pot.dhat
-    return round(float(np.median(d[active] / dmin[active])), 5) if active.any() else None
+    """Median ``d / (r_a + r_b)`` of the pairs (and floor points) carrying force at ``where``
+    (``contact_ratios``: inside the barrier's zone, which ends at touching), null when none
+    does."""
+    ratios = pot.contact_ratios(where)
+    return round(float(np.median(ratios)), 5) if len(ratios) else None
+
+
+def _overlaps(pot, where) -> int:  # type: ignore[no-untyped-def]
+    """Allowed pairs of a one-layer filament closer than ``r_a + r_b`` less the contact's
+    offset: the admissibility check's count (``rotomorph.lattice.admissibility``), for which a
+    pressed contact may settle inside touching by less than the offset."""
+    d, touching = pot.distances(where)
+    return int(np.count_nonzero(d < touching - pot.offset))
 
 
 def _bound(res):  # type: ignore[no-untyped-def]
@@ -133,10 +142,7 @@ def filament_case(case: str, program, radius: float, steps: int) -> dict:  # typ
     from rotomorph.design.network import Network
 
     pot = ContactPotential(contact, Network.chain(np.asarray(program.points, float)))
-    overlaps = 0
-    for p in sim.positions:  # one layer: the allowed pairs closer than r_a + r_b
-        d, dmin = pot.distances(p)
-        overlaps = max(overlaps, int(np.count_nonzero(d < dmin)))
+    overlaps = max(_overlaps(pot, p) for p in sim.positions)  # one layer
     return {
         "case": case,
         "n_nodes": len(sim.printed),
@@ -175,9 +181,7 @@ def euler_case() -> dict:
         "min_clearance_ratio": round(float(res.contact.clearance(res.positions)), 5),
         "contacts_active": int(res.contact.active_contacts(res.positions)),
         "stable": bool(res.stable),
-        "stack_overlaps": int(
-            np.count_nonzero(np.subtract(*res.contact.distances(res.positions)) < 0)
-        ),
+        "stack_overlaps": _overlaps(res.contact, res.positions),
         "contact_distance_ratio": _contact_ratio(res.contact, res.positions),
         "buckled": bool(np.hypot(tip[1], tip[2]) > 0.01 * case.length),
         "tip_lateral_ratio": round(float(np.hypot(tip[1], tip[2]) / case.length), 4),
@@ -216,6 +220,8 @@ def overhead_case(steps: int, repeats: int = 2) -> dict:
         "newton_iterations_on": int(on.total_iterations),
         "min_clearance_ratio": round(float(on.min_clearance.min()), 5),
         "contacts_active": int(on.contacts_active[-1]),  # type: ignore[index]
+        "stack_overlaps": int(np.max(on.stack_overlaps)),  # type: ignore[arg-type]
+        "contact_distance_ratio": _contact_ratio(_bound(on), on.states[-1]),
     }
 
 

@@ -226,3 +226,27 @@ def test_lattice_set_up_estimates_in_words():
     assert _about_bytes(4.6e6) == "about 5 MB"
     assert _about_bytes(1e3) == "about 1 MB"
     assert _about_bytes(2.54e9) == "about 2.5 GB"
+
+
+def test_paper_shows_its_plan_from_the_start(tmp_path, monkeypatch, capsys, fast_lines):
+    """``paper`` reports its planned computations before the calibrations start, so its first
+    lines say "0 of N computations" (before: a bare "0 computations" for the whole
+    calibration)."""
+    import rotomorph.simulate.report as report
+
+    class Stop(Exception):
+        pass
+
+    def calibrations():  # stands for the calibrations: long enough for a line, then stop
+        time.sleep(0.3)
+        raise Stop
+
+    monkeypatch.setattr(report, "validate_filaments", calibrations)
+    calls = []
+    with pytest.raises(Stop):
+        report.paper_report(tmp_path, quick=True, progress=lambda *a: calls.append(a))
+    assert calls == [(0, 5)]  # the calibrations, three filament sections, the authors' Fig. 4
+    with pytest.raises(Stop):
+        main(["paper", "-o", str(tmp_path / "out"), "--quick"])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if "rotomorph: paper:" in ln]
+    assert lines and all(re.match(r"rotomorph: paper: 0 of 5 computations", ln) for ln in lines)

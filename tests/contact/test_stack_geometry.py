@@ -106,3 +106,26 @@ def test_layers_of_one_stack_and_its_neighbours_never_count() -> None:
     folded[11:21, 2] = 1.0
     found = stack_overlaps(folded, edges, up, r, stack, excl)
     assert found.count > 0
+
+
+@pytest.mark.parametrize(("depth", "counted"), [(0.5, 0), (0.99, 0), (1.01, 1), (2.0, 1)])
+def test_an_overlap_counts_once_deeper_than_the_contact_offset(depth, counted) -> None:
+    """Two crossing three-layer segments whose facing layers overlap by ``depth`` x the
+    tolerance (the contact's offset, 6 um at the default): a pressed contact inside it is
+    contact, a deeper overlap interpenetration; with no tolerance every overlap counts."""
+    offset = 0.01 * 2 * R  # Contact.offset's default: the activation distance
+    stack = Stack.layered(3, 0.6)
+    gap = 2 * R + 2 * 0.6 - depth * offset  # centre lines; the facing layers overlap by depth
+    x = np.array([[-1.0, 0, 0], [1.0, 0, 0], [0, -1.0, gap], [0, 1.0, gap]])
+    edges = np.array([[0, 1], [2, 3]])
+    up = np.tile([0.0, 0.0, 1.0], (2, 1))
+    r = np.full(2, R)
+    printed = x + np.array([0.0, 0.0, 5.0]) * (np.arange(4) >= 2)[:, None]  # printed apart
+    excl = stack_exclusion(printed, edges, up, r, stack, offset)  # a segment's own layers
+    found = stack_overlaps(x, edges, up, r, stack, excl, tolerance=offset)
+    assert found.count == counted
+    strict = stack_overlaps(x, edges, up, r, stack, excl)
+    assert strict.count == 1
+    assert strict.deepest == pytest.approx(depth * offset, rel=1e-9)
+    # one layer each, nothing excluded: their centre lines are far apart
+    assert stack_overlaps(x, edges, up, r, Stack(), np.zeros(0, dtype=np.int64)).count == 0

@@ -222,3 +222,23 @@ def test_a_single_layer_lattice_keeps_the_plain_contact() -> None:
     three = contact_settings(sinusoidal_lattice(3), one.network.nodes, True, True, 0.0)
     assert three is not None and three.stack == STACK
     assert three.floor is not None and three.floor.height == pytest.approx(-0.6 - 1.005 * R)
+
+
+def test_contact_ratios_count_only_the_layer_pairs_that_carry_force() -> None:
+    """Two crossing stacks: their facing layers just apart (0.5 % of a diameter outside
+    touching) carry no force and are not among the contact ratios, though they are within the
+    activation distance of touching; pressed 0.3 % inside touching they carry force and are."""
+    net = _crossing(3.0)
+    up = np.tile([0.0, 0.0, 1.0], (net.n_edges, 1))
+    pot = StackedContact(Contact(radius=R, stack=STACK), net, up, force_scale=1e-3)
+    touching = 2 * R + 2 * 0.6  # centre lines of the rods when the facing layers touch
+    apart = (_crossing(touching + 0.005 * 2 * R).nodes, up)
+    d, contact_distance = pot.distances(apart)
+    assert np.any(d < contact_distance + pot.layers.dhat)  # near, yet apart
+    assert len(pot.contact_ratios(apart)) == 0
+    assert pot.active_contacts(apart) == 0
+    pressed = (_crossing(touching - 0.003 * 2 * R).nodes, up)
+    ratios = pot.contact_ratios(pressed)
+    assert len(ratios) == pot.active_contacts(pressed) > 0
+    assert np.min(ratios) == pytest.approx(0.997, abs=1e-9)
+    assert np.all(ratios < 1.0)

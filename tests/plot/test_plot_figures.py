@@ -12,7 +12,7 @@ from PIL import Image
 
 from rotomorph.errors import InvalidParameterError
 from rotomorph.plot.animate import animate_gif
-from rotomorph.plot.figure import figure_to_rgb, save_figure
+from rotomorph.plot.figure import crowded_ticks, figure_to_rgb, new_figure, save_figure
 from rotomorph.plot.report import plot_measured_vs_predicted, plot_parity
 from rotomorph.plot.shapes import plot_lattice_views, plot_network_3d, segment_values
 
@@ -154,6 +154,39 @@ def test_save_figure_rejects_unknown_suffix_and_is_atomic(tmp_path):
     with pytest.raises(InvalidParameterError, match="suffix"):
         save_figure(fig, tmp_path / "x.txt")
     assert os.listdir(tmp_path) == []
+
+
+def _strain_panels():
+    """Two 4-inch panels of signed three-decimal strains, as the report's Fig. 4C/F draws them:
+    matplotlib's default ticks (every 0.025) run into each other there."""
+    fig = new_figure(10.0, 5.0)
+    axes = fig.subplots(1, 2)
+    axes[0].plot([-0.158, -0.094, 0.0], [0.18, 0.12, 0.0], "ko-")
+    axes[1].plot([0.0, 0.039, 0.071], [0.0, 0.0, 0.066], "ko-")
+    axes[0].set_ylim(1e-4, 1.0)
+    axes[0].set_yscale("log")  # a log axis keeps its own ticks
+    fig.subplots_adjust(wspace=0.3)
+    return fig, axes
+
+
+def test_saved_figures_thin_tick_labels_that_run_into_each_other(tmp_path):
+    fig, axes = _strain_panels()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert crowded_ticks(axes[0].xaxis, renderer)  # matplotlib's default: labels touch
+    before = [t.get_text() for t in axes[1].xaxis.get_ticklabels()]
+    save_figure(fig, tmp_path / "strain.png")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        assert not crowded_ticks(ax.xaxis, renderer)
+        assert not crowded_ticks(ax.yaxis, renderer)
+    lo, hi = axes[0].get_xlim()
+    inside = [x for x in axes[0].get_xticks() if lo <= x <= hi]
+    assert len(inside) >= 3  # still a scale to read
+    # an axis whose labels stood apart is left as it was
+    assert [t.get_text() for t in axes[1].xaxis.get_ticklabels()] == before
+    assert axes[0].get_yscale() == "log"
 
 
 def test_segment_values_ignore_nan():

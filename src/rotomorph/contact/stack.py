@@ -357,9 +357,10 @@ def stack_overlaps(
     cand = np.sort(cand, axis=1)
     big = ne * n_layers
     keys = cand[:, 0] * big + cand[:, 1]
-    pos = np.searchsorted(excluded, keys)
-    hit = (pos < len(excluded)) & (excluded[np.minimum(pos, len(excluded) - 1)] == keys)
-    cand = cand[~hit]
+    if len(excluded):  # (none excluded: every pair is tested)
+        pos = np.searchsorted(excluded, keys)
+        hit = (pos < len(excluded)) & (excluded[np.minimum(pos, len(excluded) - 1)] == keys)
+        cand = cand[~hit]
     if not len(cand):
         return empty
     quads = np.ascontiguousarray(np.concatenate([vedges[cand[:, 0]], vedges[cand[:, 1]]], 1))

@@ -309,6 +309,12 @@ class StackedContact:
         """Smallest ``d / (r_a + r_b)`` over the layer pairs allowed to touch and obstacles."""
         return self.layers.clearance(self.points(*_state(x)))
 
+    def contact_ratios(self, x: StateLike) -> FloatArray:
+        """``d / (r_a + r_b)`` of every layer pair (and floor point) carrying contact force
+        (:meth:`ContactPotential.contact_ratios
+        <rotomorph.contact.potential.ContactPotential.contact_ratios>` of the layers)."""
+        return self.layers.contact_ratios(self.points(*_state(x)))
+
     def active_contacts(self, x: StateLike) -> int:
         """Layer pairs (and floor points) inside the activation distance."""
         return self.layers.active_contacts(self.points(*_state(x)))

@@ -244,17 +244,28 @@ def _helix_rejection(sim: FilamentSimulation) -> str | None:
     return None
 
 
+def shape_label(sim: FilamentSimulation) -> str | None:
+    """The morphology label of a simulated filament's final shape where it describes the shape:
+    ``"straight"`` and ``"twisted rod"`` (labels of a straight centre line, which claim no
+    helix), or ``"helix"``/``"coil"`` where the fitted helix fits (rms residual below
+    :data:`HELIX_FIT_RTOL` of its radius, at least :data:`HELIX_MIN_TURNS` turns); ``None``
+    otherwise (a gently bent arc is not a coil, a sinusoid not a helix). ``summary.json`` and
+    sweep tables both give this."""
+    if sim.morphology.value in ("straight", "twisted rod") or _helix_rejection(sim) is None:
+        return str(sim.morphology.value)
+    return None
+
+
 def _filament_summary(sim: FilamentSimulation) -> dict[str, Any]:
     # a shape label and a helix fit only where the fitted helix describes the shape (not on
     # sinusoids or graded filaments, whose fits leave millimetre residuals, nor on a
     # straightened sinusoid that a helix of 70 mm radius and 0.06 turn fits to 0.1 mm)
     rejection = _helix_rejection(sim)
     fits = rejection is None
-    straight = sim.morphology.value == "straight"
     out: dict[str, Any] = {
         "name": sim.name,
         "end_to_end_ratio": sim.final_ratio,
-        "morphology": sim.morphology.value if fits or straight else None,
+        "morphology": shape_label(sim),
         "iterations": int(sim.iterations.sum()),
         "wall_time_s": round(sim.wall_time, 3),
     }

@@ -1300,6 +1300,8 @@ def paper_report(
         plan["total"] += n
 
     timings: dict[str, float] = {}
+    if progress is not None:  # the plan so far shows from the start, not a bare count
+        progress(0, plan["total"])
     phase_log.info("calibrations and filament predictions", extra={"task": True})
     val = validate_filaments()
     fit = val.calibrations["all"].chosen

@@ -213,6 +213,10 @@ def plot_phase_diagram(
                 edgecolors=colour,
                 label=f"{name} (self-intersecting)",
             )
+    unlabelled = ok & np.array([lab is None for lab in labels])
+    if unlabelled.any():  # solved, but no helix describes the shape (a gently bent arc)
+        ax.scatter(xs[unlabelled], ys[unlabelled], s=40, marker="o", facecolors="none",
+                   edgecolors="0.4", label="no helix fits (a gently bent arc, other)")  # fmt: skip
     if (~ok).any():
         ax.scatter(xs[~ok], ys[~ok], s=40, marker="x", color="0.4", label="invalid / failed")
     ax.set_xlabel(x + _unit(table, x))

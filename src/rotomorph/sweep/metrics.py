@@ -57,7 +57,8 @@ METRICS: tuple[Metric, ...] = (
         "",
         "str",
         "filament",
-        "straight / twisted rod / helix / coil (median curvature and material twist)",
+        "straight / twisted rod / helix / coil (median curvature and material twist); null "
+        "where the fitted helix does not describe the shape, as in summary.json",
         True,
     ),
     Metric("curvature", "1/mm", "float", "filament", "median curvature of the final shape", True),
@@ -223,13 +224,15 @@ def filament_metrics(sim: Any, summary: Mapping[str, Any]) -> dict[str, Any]:
         Its entry in the described run's ``metadata["filaments"]``
         (:func:`rotomorph.simulate.run_data.describe_run`): clearance and verdict.
     """
+    from rotomorph.simulate.design import shape_label
+
     helix = sim.helix
     closed = sim.closed_form
     stable = _last_flag(sim.stable)
     clearance = summary.get("min_clearance_diameters")
     return {
         "end_to_end_ratio": _number(sim.final_ratio),
-        "morphology": sim.morphology.value,
+        "morphology": shape_label(sim),
         "curvature": _number(np.nanmedian(sim.curvature[-1])),
         "torsion": None if helix is None else _number(helix.torsion),
         "morphology_parameter": None,
