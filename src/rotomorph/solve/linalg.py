@@ -107,6 +107,17 @@ class Factor:
     def __init__(self, kind: str, data: Any) -> None:
         self._kind, self._data = kind, data
 
+    @property
+    def kind(self) -> str:
+        """``"banded"``, ``"cholesky"`` (compiled sparse), ``"sparse"`` (SuperLU) or ``"dense"``."""
+        return self._kind
+
+    @property
+    def data(self) -> Any:
+        """The factor itself: ``(U, u)`` banded, a :class:`SparseCholesky`, SuperLU's object or
+        LAPACK's upper triangle."""
+        return self._data
+
     def solve(self, rhs: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
         if self._kind == "banded":

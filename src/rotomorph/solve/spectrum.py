@@ -56,8 +56,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
-from rotomorph.solve.lanczos import shift_invert_lanczos
-from rotomorph.solve.linalg import BandedMatrix, SparseMatrix, factorize, matvec
+from rotomorph.solve.lanczos import (
+    Steps,
+    banded_steps,
+    shift_invert_lanczos,
+    supernodal_steps,
+)
+from rotomorph.solve.linalg import BandedMatrix, Factor, SparseMatrix, factorize, matvec
 
 __all__ = ["DENSE_LIMIT", "Spectrum", "analyse_hessian", "to_csc"]
 
@@ -368,6 +373,16 @@ def _dense_eigen(H: Any, M: FloatArray, R: FloatArray, want: int) -> tuple[Float
     return lam, vec
 
 
+def _compiled_steps(fac: Factor, M: FloatArray, R: FloatArray) -> Steps | None:
+    """The Lanczos steps of ``op_inv`` compiled, for the compiled factors (None otherwise)."""
+    if fac.kind == "banded":
+        c, u = fac.data
+        return banded_steps(c, u, M, R)
+    if fac.kind == "cholesky":
+        return supernodal_steps(*fac.data.arrays, M, R)
+    return None
+
+
 def _sparse_eigen(
     H: Any,
     M: FloatArray,
@@ -411,7 +426,9 @@ def _sparse_eigen(
 
     v0 = project(np.cos(np.arange(n) * 2.399963229728653) + 0.5)
     basis = 0 if want == 1 else max(2 * want + 1, 20)  # repeated eigenvalues: see min_steps
-    found = shift_invert_lanczos(op_inv, M, v0, want, min_steps=basis)
+    found = shift_invert_lanczos(
+        op_inv, M, v0, want, min_steps=basis, steps_kernel=_compiled_steps(fac, M, R)
+    )
     if found is not None:
         theta, vec = found
         lam = sigma + 1.0 / theta[::-1]  # the largest theta is the lowest eigenvalue
