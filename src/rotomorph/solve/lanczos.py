@@ -13,9 +13,10 @@ at every step instead of after a fixed basis size.
 
 The steps themselves (one solve, the projection, the recurrence and both
 reorthogonalisation passes) can run compiled, in one call between convergence tests
-(:func:`banded_steps`, :func:`supernodal_steps`): at a few hundred unknowns a step's twenty-odd small NumPy calls cost
-several times its solve. The compiled steps do the same operations in the same order; only
-the order of the sums inside each inner product differs, so the Ritz values agree to round-off.
+(:func:`banded_steps`, :func:`supernodal_steps`): at a few hundred unknowns a step's
+twenty-odd small NumPy calls cost several times its solve. The compiled steps do the same
+operations in the same order; only the order of the sums inside each inner product differs, so
+the Ritz values agree to round-off.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 import scipy.linalg as sla
 from numba import njit
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.solve.banded import banded_cholesky_solve
 from rotomorph.solve.supernodal import solve_numeric
 
@@ -223,7 +224,11 @@ def banded_steps(c: FloatArray, u: int, M: FloatArray, R: FloatArray) -> Steps:
 
 
 def supernodal_steps(
-    structure: tuple[FloatArray, ...], lx: FloatArray, perm: FloatArray, M: FloatArray, R: FloatArray
+    structure: tuple[IntArray, ...],
+    lx: FloatArray,
+    perm: IntArray,
+    M: FloatArray,
+    R: FloatArray,
 ) -> Steps:
     """As :func:`banded_steps` with a supernodal factor (``structure = (first, rp, ri, px)``
     and values ``lx`` of :mod:`rotomorph.solve.supernodal`, ordering ``perm``)."""
