@@ -137,6 +137,27 @@ def _banded_matvec(ab, u, x):  # pragma: no cover - compiled
     return y
 
 
+@njit(cache=True)
+def _csc_matmat(indptr, indices, data, X):  # pragma: no cover - compiled
+    """``A @ X`` column by column, each in the order of :func:`_csc_matvec`."""
+    Y = np.zeros((indptr.shape[0] - 1, X.shape[1]))
+    for c in range(X.shape[1]):
+        for j in range(indptr.shape[0] - 1):
+            xj = X[j, c]
+            for p in range(indptr[j], indptr[j + 1]):
+                Y[indices[p], c] += data[p] * xj
+    return Y
+
+
+def matmat(H: Any, X: FloatArray) -> FloatArray:
+    """``H @ X`` ``(n, k)`` for a banded, sparse or dense symmetric matrix; each column as
+    :func:`matvec` computes it."""
+    if isinstance(H, SparseMatrix):
+        return _csc_matmat(H.indptr, H.indices, H.data, np.asarray(X, dtype=float))
+    cols = [matvec(H, np.ascontiguousarray(X[:, j])) for j in range(X.shape[1])]
+    return np.column_stack(cols) if cols else np.zeros((len(X), 0))
+
+
 def diagonal(H: Any) -> FloatArray:
     """Main diagonal of a banded, sparse or dense symmetric matrix."""
     if isinstance(H, BandedMatrix):

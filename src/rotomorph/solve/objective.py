@@ -636,11 +636,14 @@ class RodObjective:
         m = self._node_metric
         r = x - m @ x / m.sum()
         modes = np.zeros((lay.count, 6))
-        for k in range(3):
-            modes[lay.pos + k, k] = 1.0
-            axis = np.eye(3)[k]
-            modes[self._pos_index, 3 + k] = np.cross(axis, r).ravel()
-            modes[lay.theta, 3 + k] = self.base.tangents[:, k]
+        node = np.zeros((len(x), 3, 6))  # per node and coordinate
+        node[:, [0, 1, 2], [0, 1, 2]] = 1.0
+        # rotations about the axes e_k: e_k x r
+        node[:, 1, 3], node[:, 2, 3] = -r[:, 2], r[:, 1]
+        node[:, 0, 4], node[:, 2, 4] = r[:, 2], -r[:, 0]
+        node[:, 0, 5], node[:, 1, 5] = -r[:, 1], r[:, 0]
+        modes[self._pos_index] = node.reshape(-1, 6)
+        modes[lay.theta, 3:] = self.base.tangents
         return modes[self.free]
 
 

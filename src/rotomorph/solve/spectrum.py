@@ -62,7 +62,14 @@ from rotomorph.solve.lanczos import (
     shift_invert_lanczos,
     supernodal_steps,
 )
-from rotomorph.solve.linalg import BandedMatrix, Factor, SparseMatrix, factorize, matvec
+from rotomorph.solve.linalg import (
+    BandedMatrix,
+    Factor,
+    SparseMatrix,
+    factorize,
+    matmat,
+    matvec,
+)
 
 __all__ = ["DENSE_LIMIT", "Spectrum", "analyse_hessian", "to_csc"]
 
@@ -203,15 +210,14 @@ def _rigid_directions(
     if rigid.size == 0:
         return _Rigid(np.zeros((n, 0)), np.zeros(0), np.zeros(0))
     # M-orthonormalise through the small Gram matrix (k <= 6 columns)
-    G = np.einsum("ik,i,il->kl", rigid, M, rigid)
+    G = (M[:, None] * rigid).T @ rigid
     w, V = np.linalg.eigh(G)
     ok = w > 1e-12 * max(float(w.max()), 1e-300)
     to_basis = V[:, ok] / np.sqrt(w[ok])
     basis = rigid @ to_basis
     if basis.shape[1] == 0:
         return _Rigid(basis, np.zeros(0), np.zeros(0))
-    cols = range(basis.shape[1])
-    HB = np.column_stack([matvec(H, np.ascontiguousarray(basis[:, j])) for j in cols])
+    HB = matmat(H, basis)
     if action is not None:
         HB = HB - action @ to_basis
     C = basis.T @ HB
