@@ -385,7 +385,8 @@ def _compiled_steps(fac: Factor, M: FloatArray, R: FloatArray) -> Steps | None:
         c, u = fac.data
         return banded_steps(c, u, M, R)
     if fac.kind == "cholesky":
-        return supernodal_steps(*fac.data.arrays, M, R)
+        structure, lx, perm = fac.data.arrays
+        return supernodal_steps(structure, lx, perm, M, R)
     return None
 
 
