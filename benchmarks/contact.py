@@ -19,7 +19,10 @@ bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
   lattices at the sizes labs print next (2 321 and 8 841 nodes), 8-step ramps, run only when
   named (a 21 x 21 ramp takes minutes); every lattice line also gives ``energy_nmm`` (the end
   state's total energy, to compare end states) and ``s_per_iteration`` (CPU time per Newton
-  iteration, whose growth with ``n_nodes`` is the per-iteration cost's scaling);
+  iteration, whose growth with ``n_nodes`` is the per-iteration cost's scaling); where one run
+  measures a pattern at two sizes or more, a ``<pattern>-iteration-scaling`` line gives
+  ``n_nodes`` and ``per_iteration_s`` per size and the ``exponent`` fitted to
+  ``per_iteration_s ~ n_nodes^exponent`` (least squares in log-log);
 * ``composite-coil``: the composite filament (active fraction 0.5) at ω* = 0.06, heated to
   175 °C with self-contact;
 * ``contracting-sinusoid``: the paper's contracting sinusoid with self-contact;
@@ -29,8 +32,9 @@ bias) and, for lattices, ``area_ratio`` and ``gaussian_sign``:
   best of two alternating runs each after a warm-up run.
 
 Run: ``python benchmarks/contact.py [--quick] [--repeat K] [CASE ...]`` (``--quick``: 4-step
-ramps; cases by name, default all but the large lattices). The lattices present their printed
-stack to contact (one capsule per layer, three layers).
+ramps; cases by name, default all but the large lattices; e.g. ``contracting-5x5
+contracting-11x11 contracting-21x21`` for the contracting lattice's scaling line). The
+lattices present their printed stack to contact (one capsule per layer, three layers).
 """
 
 from __future__ import annotations
@@ -129,6 +133,22 @@ def lattice_case(pattern: str, steps: int, repeat: int = 1, n: int = 5) -> dict:
     row["lift_off_x"] = res.first_lift_off()
     row["final_lift_mm"] = round(float(res.floor_lift[-1]), 4)  # type: ignore[index]
     return row
+
+
+def scaling_row(pattern: str, rows: list[dict]) -> dict | None:
+    """The per-iteration cost's exponent in the lattice size over ``rows`` of one pattern."""
+    if len(rows) < 2:
+        return None
+    nodes = np.array([r["n_nodes"] for r in rows], dtype=float)
+    per = np.array([r["cpu_s"] / max(r["newton_iterations"], 1) for r in rows])
+    return {
+        "case": f"{pattern}-iteration-scaling",
+        "sizes": [r["case"] for r in rows],
+        "n_nodes": [int(n) for n in nodes],
+        "newton_iterations": [r["newton_iterations"] for r in rows],
+        "per_iteration_s": [round(float(p), 6) for p in per],
+        "exponent": round(float(np.polyfit(np.log(nodes), np.log(per), 1)[0]), 3),
+    }
 
 
 def filament_case(case: str, program, radius: float, steps: int) -> dict:  # type: ignore[no-untyped-def]
@@ -234,15 +254,28 @@ def main(quick: bool = False, only: tuple[str, ...] = (), repeat: int = 1) -> No
 
     steps = 4 if quick else 16
     heat_lattice(sinusoidal_lattice(n=2, ghost_nodes=2), steps=1, contact=True)  # compile
+    # ... and the floor, buoyancy and printed-stack paths the lattice cases take, so that the
+    # first lattice timed does not pay for their compilation
+    small = sinusoidal_lattice(n=2, ghost_nodes=2, pattern="contracting")
+    heat_lattice(small, steps=1, floor=True, gravity=lattice_buoyancy(small))
     if wanted("contact-overhead"):
         _emit(overhead_case(steps))
+    lattices: dict[str, list[dict]] = {}
     for pattern in ("contracting", "dome", "saddle"):
         if wanted(f"{pattern}-5x5"):
-            _emit(lattice_case(pattern, steps, repeat))
+            row = lattice_case(pattern, steps, repeat)
+            lattices.setdefault(pattern, []).append(row)
+            _emit(row)
     for n in LARGE:
         for pattern in ("contracting", "dome"):
             if f"{pattern}-{n}x{n}" in only:
-                _emit(lattice_case(pattern, 4 if quick else LARGE_STEPS, repeat, n))
+                row = lattice_case(pattern, 4 if quick else LARGE_STEPS, repeat, n)
+                lattices.setdefault(pattern, []).append(row)
+                _emit(row)
+    for pattern, rows in lattices.items():
+        scaling = scaling_row(pattern, rows)
+        if scaling is not None:
+            _emit(scaling)
     if wanted("composite-coil"):
         coil = Filament(
             speed=3.0,

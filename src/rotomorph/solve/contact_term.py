@@ -124,7 +124,7 @@ class HessianPattern:
         _add_at(data, self._base_pos, base.data)  # data[pos] += base.data, compiled
         assert self._sym is not None
         indices, indptr = self._union
-        return SparseMatrix(sp.csc_matrix((data, indices, indptr), shape=(n, n)), self._sym)
+        return SparseMatrix.from_arrays(data, indices, indptr, self._sym)
 
     def _known_base(self, base: sp.csc_matrix) -> bool:
         """Whether ``base`` has the pattern of the base the union was last grown with."""

@@ -10,6 +10,13 @@ Eigenvalue Problem*, 1998, §6.9), so no spurious copies appear. The iteration s
 each wanted Ritz value's residual estimate ``|beta_j s_j|`` is within ``tol`` of it, the test
 ARPACK applies (Lehoucq, Sorensen & Yang, *ARPACK Users' Guide*, SIAM 1998, §4.6), but checked
 at every step instead of after a fixed basis size.
+
+The steps themselves (one solve, the projection, the recurrence and both
+reorthogonalisation passes) can run compiled, in one call between convergence tests
+(:func:`banded_steps`, :func:`supernodal_steps`): at a few hundred unknowns a step's
+twenty-odd small NumPy calls cost several times its solve. The compiled steps do the same
+operations in the same order; only the order of the sums inside each inner product differs, so
+the Ritz values agree to round-off.
 """
 
 from __future__ import annotations
@@ -18,10 +25,17 @@ from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg as sla
+from numba import njit
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import FloatArray, IntArray
+from rotomorph.solve.banded import banded_cholesky_solve
+from rotomorph.solve.supernodal import solve_numeric
 
-__all__ = ["shift_invert_lanczos"]
+__all__ = ["Steps", "banded_steps", "shift_invert_lanczos", "supernodal_steps"]
+
+#: ``steps(basis, alpha, beta, j0, j1) -> j``: Lanczos steps ``j0 .. j1 - 1`` done in place,
+#: stopping early after a step whose ``beta`` is not positive; returns the last step done
+Steps = Callable[[FloatArray, FloatArray, FloatArray, int, int], int]
 
 
 def shift_invert_lanczos(
@@ -33,6 +47,7 @@ def shift_invert_lanczos(
     tol: float = 1e-10,
     min_steps: int = 0,
     max_steps: int = 120,
+    steps_kernel: Steps | None = None,
 ) -> tuple[FloatArray, FloatArray] | None:
     """The ``count`` largest eigenvalues ``theta`` of ``S = apply(M x)`` and their vectors.
 
@@ -56,6 +71,9 @@ def shift_invert_lanczos(
     max_steps
         Largest basis; None is returned when the wanted values have not converged by then (or
         the start vector spans fewer than ``count`` directions).
+    steps_kernel
+        The same steps compiled (:func:`banded_steps`, :func:`supernodal_steps`), run in one
+        call up to each convergence test; ``apply`` is then not called.
 
     Returns
     -------
@@ -72,17 +90,25 @@ def shift_invert_lanczos(
     if not norm > 0.0:
         return None
     basis[0] = q / norm
-    for j in range(steps):
-        w = apply(M * basis[j])
-        alpha[j] = basis[j] @ (M * w)
-        w = w - alpha[j] * basis[j]
-        if j:
-            w -= beta[j - 1] * basis[j - 1]
-        for _ in range(2):
-            w -= (basis[: j + 1] @ (M * w)) @ basis[: j + 1]
-        beta[j] = np.sqrt(w @ (M * w))
+    first = max(count, min(min_steps, steps))  # the first basis size that is tested
+    j = 0
+    while j < steps:
+        if steps_kernel is not None:
+            # every step up to the next test in one compiled call; j: the last step done
+            j = steps_kernel(basis, alpha, beta, j, max(j + 1, min(first, steps)))
+        else:
+            w = apply(M * basis[j])
+            alpha[j] = basis[j] @ (M * w)
+            w = w - alpha[j] * basis[j]
+            if j:
+                w -= beta[j - 1] * basis[j - 1]
+            for _ in range(2):
+                w -= (basis[: j + 1] @ (M * w)) @ basis[: j + 1]
+            beta[j] = np.sqrt(w @ (M * w))
+            if beta[j] > 0.0:
+                basis[j + 1] = w / beta[j]
         m = j + 1
-        if m >= max(count, min(min_steps, steps)):
+        if m >= first:
             theta, s = sla.eigh_tridiagonal(alpha[:m], beta[: m - 1])
             top = slice(m - count, m)
             residual = np.abs(beta[j] * s[-1, top])
@@ -91,5 +117,124 @@ def shift_invert_lanczos(
                 return theta[top], basis[:m].T @ s[:, top]
         if not beta[j] > 0.0:
             return None
-        basis[j + 1] = w / beta[j]
+        j += 1
     return None
+
+
+@njit(cache=True)
+def _rhs(M, v, R, RM):  # pragma: no cover - compiled
+    """``b = M v`` with the rigid loads removed, ``b - RM^T (R^T b)``."""
+    n, k = R.shape
+    b = M * v
+    if k:
+        c = np.zeros(k)
+        for i in range(n):
+            for a in range(k):
+                c[a] += R[i, a] * b[i]
+        for i in range(n):
+            s = 0.0
+            for a in range(k):
+                s += RM[a, i] * c[a]
+            b[i] -= s
+    return b
+
+
+@njit(cache=True)
+def _recurrence(w, M, R, RM, basis, alpha, beta, j):  # pragma: no cover - compiled
+    """Step ``j`` after its solve ``w``: projection, three-term recurrence, two passes of
+    full reorthogonalisation, ``beta[j]`` and the next basis vector; False if ``beta[j]`` is
+    not positive."""
+    n, k = R.shape
+    if k:  # the M-orthogonal projector I - R R^T M
+        c = np.zeros(k)
+        for i in range(n):
+            for a in range(k):
+                c[a] += RM[a, i] * w[i]
+        for i in range(n):
+            s = 0.0
+            for a in range(k):
+                s += R[i, a] * c[a]
+            w[i] -= s
+    q = basis[j]
+    a_j = 0.0
+    for i in range(n):
+        a_j += q[i] * (M[i] * w[i])
+    alpha[j] = a_j
+    for i in range(n):
+        w[i] -= a_j * q[i]
+    if j:
+        p = basis[j - 1]
+        bp = beta[j - 1]
+        for i in range(n):
+            w[i] -= bp * p[i]
+    h = np.empty(j + 1)
+    for _ in range(2):
+        for r in range(j + 1):
+            s = 0.0
+            row = basis[r]
+            for i in range(n):
+                s += row[i] * (M[i] * w[i])
+            h[r] = s
+        for r in range(j + 1):
+            row = basis[r]
+            hr = h[r]
+            for i in range(n):
+                w[i] -= hr * row[i]
+    s = 0.0
+    for i in range(n):
+        s += w[i] * (M[i] * w[i])
+    beta[j] = np.sqrt(s)
+    if not beta[j] > 0.0:
+        return False
+    nxt = basis[j + 1]
+    for i in range(n):
+        nxt[i] = w[i] / beta[j]
+    return True
+
+
+@njit(cache=True)
+def _banded_steps(c, u, M, R, RM, basis, alpha, beta, j0, j1):  # pragma: no cover - compiled
+    for j in range(j0, j1):
+        w = banded_cholesky_solve(c, u, _rhs(M, basis[j], R, RM))
+        if not _recurrence(w, M, R, RM, basis, alpha, beta, j):
+            return j
+    return j1 - 1
+
+
+@njit(cache=True)
+def _supernodal_steps(
+    first, rp, ri, px, lx, perm, M, R, RM, basis, alpha, beta, j0, j1
+):  # pragma: no cover - compiled
+    for j in range(j0, j1):
+        w = solve_numeric(first, rp, ri, px, lx, perm, _rhs(M, basis[j], R, RM))
+        if not _recurrence(w, M, R, RM, basis, alpha, beta, j):
+            return j
+    return j1 - 1
+
+
+def banded_steps(c: FloatArray, u: int, M: FloatArray, R: FloatArray) -> Steps:
+    """Compiled steps of ``S = P (H - sigma M)^{-1} P^T M`` with the banded Cholesky factor
+    ``c`` (upper, half-bandwidth ``u``) of ``H - sigma M`` and the ``M``-orthogonal projector
+    ``P = I - R R^T M`` off the ``M``-orthonormal columns ``R`` ``(n, k)``."""
+    R = np.ascontiguousarray(R, dtype=float)
+    RM = np.ascontiguousarray((M[:, None] * R).T)
+    return lambda basis, alpha, beta, j0, j1: int(
+        _banded_steps(c, u, M, R, RM, basis, alpha, beta, j0, j1)
+    )
+
+
+def supernodal_steps(
+    structure: tuple[IntArray, ...],
+    lx: FloatArray,
+    perm: IntArray,
+    M: FloatArray,
+    R: FloatArray,
+) -> Steps:
+    """As :func:`banded_steps` with a supernodal factor (``structure = (first, rp, ri, px)``
+    and values ``lx`` of :mod:`rotomorph.solve.supernodal`, ordering ``perm``)."""
+    R = np.ascontiguousarray(R, dtype=float)
+    RM = np.ascontiguousarray((M[:, None] * R).T)
+    first, rp, ri, px = structure
+    return lambda basis, alpha, beta, j0, j1: int(
+        _supernodal_steps(first, rp, ri, px, lx, perm, M, R, RM, basis, alpha, beta, j0, j1)
+    )

@@ -21,7 +21,7 @@ import scipy.sparse.linalg as spla
 from numba import njit
 from scipy.linalg import lapack
 
-from rotomorph._typing import FloatArray
+from rotomorph._typing import FloatArray, IntArray
 from rotomorph.solve.banded import banded_cholesky, banded_cholesky_solve
 from rotomorph.solve.sparse_cholesky import Symbolic, factor
 
@@ -54,22 +54,74 @@ class BandedMatrix:
         return out
 
 
-@dataclass(frozen=True, eq=False)
 class SparseMatrix:
-    """A symmetric sparse matrix (full pattern, CSC) with its cached symbolic Cholesky."""
+    """A symmetric sparse matrix (full pattern, CSC) with its cached symbolic Cholesky.
 
-    csc: sp.csc_matrix
-    symbolic: Symbolic
+    Made from a SciPy CSC matrix, or (:meth:`from_arrays`, as the Newton loop refills a fixed
+    pattern) from its CSC arrays alone: the SciPy matrix is then built only when ``csc`` is
+    asked for, since its constructor's checks cost more than refilling the values. Diagonal
+    and products come from the arrays (the same sums in the same order as SciPy's).
+    """
+
+    __slots__ = ("_csc", "data", "indices", "indptr", "symbolic")
+
+    def __init__(self, csc: sp.csc_matrix, symbolic: Symbolic) -> None:
+        self._csc: sp.csc_matrix | None = csc
+        self.data: FloatArray = csc.data
+        self.indices: IntArray = csc.indices
+        self.indptr: IntArray = csc.indptr
+        self.symbolic = symbolic
+
+    @classmethod
+    def from_arrays(
+        cls, data: FloatArray, indices: IntArray, indptr: IntArray, symbolic: Symbolic
+    ) -> SparseMatrix:
+        """The matrix with CSC arrays ``data, indices, indptr`` (full symmetric pattern, rows
+        sorted in each column, the pattern ``symbolic`` was analysed for)."""
+        out = cls.__new__(cls)
+        out._csc = None
+        out.data, out.indices, out.indptr, out.symbolic = data, indices, indptr, symbolic
+        return out
+
+    @property
+    def n(self) -> int:
+        """Matrix size."""
+        return len(self.indptr) - 1
+
+    @property
+    def csc(self) -> sp.csc_matrix:
+        """The SciPy CSC matrix (built at the first request)."""
+        if self._csc is None:
+            n = self.n
+            self._csc = sp.csc_matrix((self.data, self.indices, self.indptr), shape=(n, n))
+        return self._csc
 
     def diagonal(self) -> FloatArray:
         """Main diagonal."""
-        return self.csc.diagonal()
+        sym = self.symbolic
+        if sym.n != self.n:  # pragma: no cover - a symbolic analysis of another pattern
+            return np.asarray(self.csc.diagonal())
+        out = np.zeros(sym.n)
+        have = sym.diag_src >= 0
+        out[sym.perm[have]] = self.data[sym.diag_src[have]]
+        return out
 
     def toarray(self) -> FloatArray:
         """Dense copy (for tests)."""
-        return self.csc.toarray()
+        return np.asarray(self.csc.toarray())
 
     to_dense = toarray
+
+
+@njit(cache=True)
+def _csc_matvec(indptr, indices, data, x):  # pragma: no cover - compiled
+    """``A @ x`` in SciPy's order (``csc_matvec``: column by column)."""
+    y = np.zeros(indptr.shape[0] - 1)
+    for j in range(indptr.shape[0] - 1):
+        xj = x[j]
+        for p in range(indptr[j], indptr[j + 1]):
+            y[indices[p]] += data[p] * xj
+    return y
 
 
 @njit(cache=True)
@@ -85,6 +137,27 @@ def _banded_matvec(ab, u, x):  # pragma: no cover - compiled
     return y
 
 
+@njit(cache=True)
+def _csc_matmat(indptr, indices, data, X):  # pragma: no cover - compiled
+    """``A @ X`` column by column, each in the order of :func:`_csc_matvec`."""
+    Y = np.zeros((indptr.shape[0] - 1, X.shape[1]))
+    for c in range(X.shape[1]):
+        for j in range(indptr.shape[0] - 1):
+            xj = X[j, c]
+            for p in range(indptr[j], indptr[j + 1]):
+                Y[indices[p], c] += data[p] * xj
+    return Y
+
+
+def matmat(H: Any, X: FloatArray) -> FloatArray:
+    """``H @ X`` ``(n, k)`` for a banded, sparse or dense symmetric matrix; each column as
+    :func:`matvec` computes it."""
+    if isinstance(H, SparseMatrix):
+        return _csc_matmat(H.indptr, H.indices, H.data, np.asarray(X, dtype=float))
+    cols = [matvec(H, np.ascontiguousarray(X[:, j])) for j in range(X.shape[1])]
+    return np.column_stack(cols) if cols else np.zeros((len(X), 0))
+
+
 def diagonal(H: Any) -> FloatArray:
     """Main diagonal of a banded, sparse or dense symmetric matrix."""
     if isinstance(H, BandedMatrix):
@@ -97,7 +170,7 @@ def matvec(H: Any, x: FloatArray) -> FloatArray:
     if isinstance(H, BandedMatrix):
         return _banded_matvec(H.ab, H.u, x)
     if isinstance(H, SparseMatrix):
-        return np.asarray(H.csc @ x)
+        return _csc_matvec(H.indptr, H.indices, H.data, np.ascontiguousarray(x, dtype=float))
     return np.asarray(H @ x)
 
 
@@ -106,6 +179,17 @@ class Factor:
 
     def __init__(self, kind: str, data: Any) -> None:
         self._kind, self._data = kind, data
+
+    @property
+    def kind(self) -> str:
+        """``"banded"``, ``"cholesky"`` (compiled sparse), ``"sparse"`` (SuperLU) or ``"dense"``."""
+        return self._kind
+
+    @property
+    def data(self) -> Any:
+        """The factor itself: ``(U, u)`` banded, a :class:`SparseCholesky`, SuperLU's object or
+        LAPACK's upper triangle."""
+        return self._data
 
     def solve(self, rhs: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
@@ -127,7 +211,7 @@ def factorize(H: Any, shift: FloatArray) -> Factor | None:
             return None
         return Factor("banded", (work, H.u))
     if isinstance(H, SparseMatrix):
-        chol = factor(H.symbolic, H.csc.data, shift)
+        chol = factor(H.symbolic, H.data, shift)
         return None if chol is None else Factor("cholesky", chol)
     if sp.issparse(H):
         A = (H + sp.diags(shift)).tocsc()

@@ -11,7 +11,6 @@ import weakref
 from typing import cast
 
 import numpy as np
-import scipy.sparse as sp
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
 from rotomorph.contact.obstacles import Floor
@@ -39,9 +38,10 @@ from rotomorph.solve.retraction import (
     remove_rigid_motion,
     split_step,
 )
-from rotomorph.solve.sparse_cholesky import analyse
+from rotomorph.solve.sparse_cholesky import analyse_pattern
 
 BANDED_LIMIT = 64  # half-bandwidth above which the sparse path is used
+_EPS = float(np.finfo(float).eps)
 
 
 class RodObjective:
@@ -80,8 +80,7 @@ class RodObjective:
         self._reduced = reduced
         self._pos_index = (lay.pos[:, None] + np.arange(3)).ravel()
         self._theta_index = lay.theta
-        self._st_dofs = lay.stencil_dofs(st)
-        self._ed_dofs = lay.edge_dofs(net.edges)
+        self._st_dofs, self._ed_dofs = topo["dofs"]
         b1, b2, c = model.stencil_stiffness
         self._stiff = (np.ascontiguousarray(b1), np.ascontiguousarray(b2), np.ascontiguousarray(c))
         k1, k2, tw = model.integrated_natural()
@@ -237,11 +236,14 @@ class RodObjective:
             + (np.linalg.norm(self._moments, axis=1).sum() if len(self._moments) else 0.0)
         )
         lay = self.model.layout
-        m = np.zeros(lay.count)
+        # each coordinate gets half of every edge at it, the edges' first ends first (the
+        # order of np.add.at over ends and coordinates: the same sums)
         half = 0.5 * rest
-        for end in (0, 1):
-            for k in range(3):
-                np.add.at(m, lay.pos[net.edges[:, end]] + k, half)
+        ends = lay.pos[np.concatenate([net.edges[:, 0], net.edges[:, 1]])]
+        weights = np.concatenate([half, half])
+        m = np.zeros(lay.count)
+        for k in range(3):
+            m += np.bincount(ends + k, weights, minlength=lay.count)
         # a twist angle is weighted like the rotation of its edge (length^3), so that the
         # shift damps twisting and bending rotations alike at every mesh size
         m[lay.theta] = rest**3
@@ -269,6 +271,7 @@ class RodObjective:
         u[self._theta_index] = state.theta
         self._u_base = u
         self._base_m1: FloatArray | None = None  # the base's material directors, when needed
+        self._floor: float | None = None  # residual_floor() of this base, when asked
 
     def vector(self, state: State | None = None) -> FloatArray:
         """Free-DOF vector of ``state`` (default: the base)."""
@@ -444,12 +447,10 @@ class RodObjective:
                 return self._contact.add_to(banded, self._contact_hess)
             return banded
         scatter_sparse(self._st_hess, self._st_slot, self._ed_hess, self._ed_slot, self._data)
-        n = len(self.free)
         indices, indptr = self._csc_pattern
-        csc = sp.csc_matrix((self._data.copy(), indices, indptr), shape=(n, n))
         if self._topo.get("symbolic") is None:
-            self._topo["symbolic"] = analyse(csc)
-        rod = SparseMatrix(csc, self._topo["symbolic"])
+            self._topo["symbolic"] = analyse_pattern(indptr, indices)
+        rod = SparseMatrix.from_arrays(self._data.copy(), indices, indptr, self._topo["symbolic"])
         if self._contact is not None and self._contact_hess is not None:
             return self._contact.add_to(rod, self._contact_hess)
         return rod
@@ -526,13 +527,10 @@ class RodObjective:
         of squares, times a safety factor 8, is the smallest residual the arithmetic resolves:
         a nearly inextensible rod far from the origin cannot reach a tighter ``rtol``.
         """
-        x = float(np.abs(self.base.positions).max())
-        return (
-            8.0
-            * float(np.finfo(float).eps)
-            * max(x, self.length_scale)
-            * (self._roundoff_stiffness)
-        )
+        if self._floor is None:  # once per base: every iteration asks
+            x = float(np.abs(self.base.positions).max())
+            self._floor = 8.0 * _EPS * max(x, self.length_scale) * (self._roundoff_stiffness)
+        return self._floor
 
     def curvature_step_scale(self, q: FloatArray, v: FloatArray) -> float:
         """Multiple of ``v`` that turns the most-turned edge by 0.2 rad."""
@@ -638,11 +636,14 @@ class RodObjective:
         m = self._node_metric
         r = x - m @ x / m.sum()
         modes = np.zeros((lay.count, 6))
-        for k in range(3):
-            modes[lay.pos + k, k] = 1.0
-            axis = np.eye(3)[k]
-            modes[self._pos_index, 3 + k] = np.cross(axis, r).ravel()
-            modes[lay.theta, 3 + k] = self.base.tangents[:, k]
+        node = np.zeros((len(x), 3, 6))  # per node and coordinate
+        node[:, [0, 1, 2], [0, 1, 2]] = 1.0
+        # rotations about the axes e_k: e_k x r
+        node[:, 1, 3], node[:, 2, 3] = -r[:, 2], r[:, 1]
+        node[:, 0, 4], node[:, 2, 4] = r[:, 2], -r[:, 0]
+        node[:, 0, 5], node[:, 1, 5] = -r[:, 1], r[:, 0]
+        modes[self._pos_index] = node.reshape(-1, 6)
+        modes[lay.theta, 3:] = self.base.tangents
         return modes[self.free]
 
 
@@ -669,9 +670,15 @@ def _topology(model: Model, fixed: BoolArray) -> dict:
             ok = hi >= 0
             spans.append(int(np.max(hi[ok] - lo[ok])) if ok.any() else 0)
     bandwidth = int(max(spans)) if spans else 0
-    topo: dict = {"bandwidth": bandwidth, "banded": bandwidth <= BANDED_LIMIT, "sparse": None}
+    dofs = (lay.stencil_dofs(st), lay.edge_dofs(net.edges))
+    topo: dict = {
+        "bandwidth": bandwidth,
+        "banded": bandwidth <= BANDED_LIMIT,
+        "sparse": None,
+        "dofs": dofs,
+    }
     if not topo["banded"]:
-        topo["sparse"] = hessian_pattern(lay.stencil_dofs(st), lay.edge_dofs(net.edges), reduced)
+        topo["sparse"] = hessian_pattern(*dofs, reduced)
     fixed_nodes = np.flatnonzero(fixed[lay.pos[:, None] + np.arange(3)].all(axis=1))
     topo["retraction"] = EdgeRotationRetraction(
         np.ascontiguousarray(net.edges), net.n_nodes, fixed_nodes

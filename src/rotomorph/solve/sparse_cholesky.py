@@ -176,6 +176,13 @@ class SparseCholesky:
     def __init__(self, sym: Symbolic, lx: FloatArray) -> None:
         self._sym, self._lx = sym, lx
 
+    @property
+    def arrays(self) -> tuple[tuple[IntArray, IntArray, IntArray, IntArray], FloatArray, IntArray]:
+        """``(first, rp, ri, px)``, the values ``lx`` and the ordering ``perm`` that
+        :func:`rotomorph.solve.supernodal.solve_numeric` takes."""
+        first, rp, ri, px = self._sym.supernodal[:4]
+        return (first, rp, ri, px), self._lx, self._sym.perm
+
     def solve(self, b: FloatArray) -> FloatArray:
         """Solve with the factored matrix."""
         first, rp, ri, px = self._sym.supernodal[:4]

@@ -56,8 +56,20 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rotomorph._typing import BoolArray, FloatArray, IntArray
-from rotomorph.solve.lanczos import shift_invert_lanczos
-from rotomorph.solve.linalg import BandedMatrix, SparseMatrix, factorize, matvec
+from rotomorph.solve.lanczos import (
+    Steps,
+    banded_steps,
+    shift_invert_lanczos,
+    supernodal_steps,
+)
+from rotomorph.solve.linalg import (
+    BandedMatrix,
+    Factor,
+    SparseMatrix,
+    factorize,
+    matmat,
+    matvec,
+)
 
 __all__ = ["DENSE_LIMIT", "Spectrum", "analyse_hessian", "to_csc"]
 
@@ -198,15 +210,14 @@ def _rigid_directions(
     if rigid.size == 0:
         return _Rigid(np.zeros((n, 0)), np.zeros(0), np.zeros(0))
     # M-orthonormalise through the small Gram matrix (k <= 6 columns)
-    G = np.einsum("ik,i,il->kl", rigid, M, rigid)
+    G = (M[:, None] * rigid).T @ rigid
     w, V = np.linalg.eigh(G)
     ok = w > 1e-12 * max(float(w.max()), 1e-300)
     to_basis = V[:, ok] / np.sqrt(w[ok])
     basis = rigid @ to_basis
     if basis.shape[1] == 0:
         return _Rigid(basis, np.zeros(0), np.zeros(0))
-    cols = range(basis.shape[1])
-    HB = np.column_stack([matvec(H, np.ascontiguousarray(basis[:, j])) for j in cols])
+    HB = matmat(H, basis)
     if action is not None:
         HB = HB - action @ to_basis
     C = basis.T @ HB
@@ -368,6 +379,17 @@ def _dense_eigen(H: Any, M: FloatArray, R: FloatArray, want: int) -> tuple[Float
     return lam, vec
 
 
+def _compiled_steps(fac: Factor, M: FloatArray, R: FloatArray) -> Steps | None:
+    """The Lanczos steps of ``op_inv`` compiled, for the compiled factors (None otherwise)."""
+    if fac.kind == "banded":
+        c, u = fac.data
+        return banded_steps(c, u, M, R)
+    if fac.kind == "cholesky":
+        structure, lx, perm = fac.data.arrays
+        return supernodal_steps(structure, lx, perm, M, R)
+    return None
+
+
 def _sparse_eigen(
     H: Any,
     M: FloatArray,
@@ -411,7 +433,9 @@ def _sparse_eigen(
 
     v0 = project(np.cos(np.arange(n) * 2.399963229728653) + 0.5)
     basis = 0 if want == 1 else max(2 * want + 1, 20)  # repeated eigenvalues: see min_steps
-    found = shift_invert_lanczos(op_inv, M, v0, want, min_steps=basis)
+    found = shift_invert_lanczos(
+        op_inv, M, v0, want, min_steps=basis, steps_kernel=_compiled_steps(fac, M, R)
+    )
     if found is not None:
         theta, vec = found
         lam = sigma + 1.0 / theta[::-1]  # the largest theta is the lowest eigenvalue
