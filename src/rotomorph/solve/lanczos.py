@@ -124,19 +124,25 @@ def shift_invert_lanczos(
 @njit(cache=True)
 def _rhs(M, v, R, RM):  # pragma: no cover - compiled
     """``b = M v`` with the rigid loads removed, ``b - RM^T (R^T b)``."""
-    n, k = R.shape
     b = M * v
+    _subtract_low_rank(b, R, RM)
+    return b
+
+
+@njit(cache=True)
+def _subtract_low_rank(x, U, V):  # pragma: no cover - compiled
+    """``x -= V^T (U^T x)`` in place, for ``U`` of shape (n, k) and ``V`` of shape (k, n)."""
+    n, k = U.shape
     if k:
         c = np.zeros(k)
         for i in range(n):
             for a in range(k):
-                c[a] += R[i, a] * b[i]
+                c[a] += U[i, a] * x[i]
         for i in range(n):
             s = 0.0
             for a in range(k):
-                s += RM[a, i] * c[a]
-            b[i] -= s
-    return b
+                s += V[a, i] * c[a]
+            x[i] -= s
 
 
 @njit(cache=True)
@@ -144,17 +150,8 @@ def _recurrence(w, M, R, RM, basis, alpha, beta, j):  # pragma: no cover - compi
     """Step ``j`` after its solve ``w``: projection, three-term recurrence, two passes of
     full reorthogonalisation, ``beta[j]`` and the next basis vector; False if ``beta[j]`` is
     not positive."""
-    n, k = R.shape
-    if k:  # the M-orthogonal projector I - R R^T M
-        c = np.zeros(k)
-        for i in range(n):
-            for a in range(k):
-                c[a] += RM[a, i] * w[i]
-        for i in range(n):
-            s = 0.0
-            for a in range(k):
-                s += R[i, a] * c[a]
-            w[i] -= s
+    n = R.shape[0]
+    _subtract_low_rank(w, RM.T, R.T)  # the M-orthogonal projector I - R R^T M
     q = basis[j]
     a_j = 0.0
     for i in range(n):
