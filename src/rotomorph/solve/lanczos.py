@@ -33,7 +33,7 @@ from rotomorph.solve.supernodal import solve_numeric
 
 __all__ = ["Steps", "banded_steps", "shift_invert_lanczos", "supernodal_steps"]
 
-#: ``steps(basis, alpha, beta, j0, j1) -> j``: Lanczos steps ``j0 .. j1 - 1`` done in place,
+#: ``steps(basis, alpha, beta, j0, j1) -> j``: Lanczos steps ``j0`` to ``j1 - 1`` done in place,
 #: stopping early after a step whose ``beta`` is not positive; returns the last step done
 Steps = Callable[[FloatArray, FloatArray, FloatArray, int, int], int]
 
