@@ -24,7 +24,9 @@ __all__ = [
     "check",
     "edge_modes",
     "error_field",
+    "format_value",
     "get_field",
+    "parse_field",
     "parse_value",
     "set_edge",
     "set_field",
@@ -61,6 +63,56 @@ def parse_value(text: Any) -> Any:
     return value if math.isfinite(value) else text
 
 
+#: Fields holding a point (``x, y, z``) or a list of points (one ``x, y, z`` per line or
+#: separated by ``;``), by the last name of their path (mm).
+POINT_FIELDS = frozenset({"start"})
+POINT_LIST_FIELDS = frozenset({"points"})
+
+
+def _point(text: str) -> list[Any] | None:
+    parts = [p for p in re.split(r"[,\s]+", text.strip().strip("[]()")) if p]
+    values = [parse_value(p) for p in parts]
+    if not values or not all(
+        isinstance(v, int | float) and not isinstance(v, bool) for v in values
+    ):
+        return None
+    return values
+
+
+def parse_field(path: str, text: Any) -> Any:
+    """What typed ``text`` means at ``path``: a point's ``x, y, z`` as a list of numbers, a
+    polyline's points (one ``x, y, z`` a line, or ``;`` between them) as a list of lists, else
+    as :func:`parse_value` reads it. Text that reads as neither stays text, which the schema
+    refuses with the CLI's message."""
+    last = path.rsplit(".", 1)[-1]
+    if not isinstance(text, str) or not text.strip():
+        return parse_value(text)
+    if last in POINT_FIELDS:
+        point = _point(text)
+        return text if point is None else point
+    if last in POINT_LIST_FIELDS:
+        rows = [r for r in re.split(r"[;\n]", text) if r.strip()]
+        points = [_point(r) for r in rows]
+        return text if any(p is None for p in points) else points
+    return parse_value(text)
+
+
+def format_value(value: Any) -> str:
+    """The text a field shows for ``value``: points as ``x, y, z`` (a list of them one a
+    line), numbers as TOML writes them, ``true``/``false``; ``""`` for none (the default)."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and value.is_integer():
+        return f"{value:g}" if abs(value) < 1e15 else repr(value)
+    if isinstance(value, list | tuple):
+        if value and all(isinstance(v, list | tuple) for v in value):
+            return "\n".join(format_value(v) for v in value)
+        return ", ".join(format_value(v) for v in value)
+    return str(value)
+
+
 def get_field(data: dict[str, Any], path: str) -> Any:
     """The value at ``path`` (None where absent)."""
     node: Any = data
@@ -73,7 +125,10 @@ def get_field(data: dict[str, Any], path: str) -> Any:
 
 
 def set_field(data: dict[str, Any], path: str, value: Any) -> dict[str, Any]:
-    """A copy of ``data`` with ``value`` at ``path`` (``None`` removes the key: its default)."""
+    """A copy of ``data`` with ``value`` at ``path`` (``None`` removes the key: its default;
+    ``data`` itself when the key is absent already, no empty table made for it)."""
+    if value is None and get_field(data, path) is None:
+        return data
     out = copy.deepcopy(data)
     parts = _parts(path)
     node: Any = out

@@ -12,7 +12,7 @@ from typing import Any
 
 from dash import dcc, html
 
-from rotomorph.app.editing import get_field
+from rotomorph.app.editing import format_value, get_field
 
 __all__ = ["NEW_SEGMENTS", "TARGETS", "page", "render_form"]
 
@@ -25,6 +25,9 @@ _FILAMENT_FIELDS = (
     ("flip_length", "flip length (mm)"),
     ("radius", "radius R (mm)"),
     ("spacing", "vertex spacing (mm)"),
+    ("start", "start x, y, z (mm)"),
+    ("heading_deg", "heading (deg)"),
+    ("initial_nozzle_angle_deg", "initial nozzle angle (deg)"),
 )
 _SEGMENT_FIELDS = {
     "line": (("length", "length (mm)"),),
@@ -34,8 +37,24 @@ _SEGMENT_FIELDS = {
         ("wavelength", "wavelength (mm)"),
         ("periods", "periods"),
     ),
-    "polyline": (),
+    "polyline": (("resample", "resample (true/false)"),),
 }
+_NOZZLE_FIELDS = (
+    ("diameter", "diameter (mm)"),
+    ("active_pressure", "active pressure (psi)"),
+    ("passive_pressure", "passive pressure (psi)"),
+    ("prime_dwell", "prime dwell (s)"),
+    ("release_dwell", "release dwell (s)"),
+    ("active_conductance", "active conductance (mm³/s/psi)"),
+    ("passive_conductance", "passive conductance (mm³/s/psi)"),
+)
+_CONTACT_FIELDS = (
+    ("self_contact", "self contact (true/false)"),
+    ("floor", "floor (true/false)"),
+    ("gravity", "gravity (true/false)"),
+    ("friction", "friction coefficient"),
+    ("path_check", "path check sub-steps"),
+)
 _SEGMENT_CONTROLS = (
     ("speed", "speed (mm/s)"),
     ("rotation_number", "ω*"),
@@ -129,29 +148,35 @@ ghost_nodes = 10
 }
 
 
-def _text(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float) and value.is_integer():
-        return f"{value:g}" if abs(value) < 1e15 else repr(value)
-    return str(value)
-
-
-def field(data: dict[str, Any], path: str, label: str, *, placeholder: str = "") -> Any:
-    """A labelled text input for ``path`` with its error line."""
+def field(
+    data: dict[str, Any], path: str, label: str, *, placeholder: str = "", rows: int = 0
+) -> Any:
+    """A labelled text input for ``path`` with its error line (``rows`` > 0: a text area of
+    that many rows, for a list of points)."""
+    id_ = {"type": "field", "path": path}
+    value = format_value(get_field(data, path))
+    box = (
+        dcc.Textarea(
+            id=id_,
+            value=value,
+            rows=rows,
+            placeholder=placeholder or "x, y, z per line",
+            className="field-input points",
+        )
+        if rows
+        else dcc.Input(
+            id=id_,
+            value=value,
+            type="text",
+            placeholder=placeholder or "default",
+            debounce=False,
+            className="field-input",
+        )
+    )
     return html.Div(
         [
             html.Label(label, className="field-label"),
-            dcc.Input(
-                id={"type": "field", "path": path},
-                value=_text(get_field(data, path)),
-                type="text",
-                placeholder=placeholder or "default",
-                debounce=False,
-                className="field-input",
-            ),
+            box,
             html.Div(id={"type": "error", "path": path}, className="field-error"),
         ],
         className="field",
@@ -180,6 +205,10 @@ def _segment(data: dict[str, Any], i: int, j: int, seg: dict[str, Any]) -> Any:
     base = f"filaments[{i}].segments[{j}]"
     kind = str(seg.get("kind", ""))
     fields = [field(data, f"{base}.{k}", label) for k, label in _SEGMENT_FIELDS.get(kind, ())]
+    if kind == "polyline":
+        points = seg.get("points") or []
+        rows = min(max(len(points), 2), 12)
+        fields.insert(0, field(data, f"{base}.points", "points x, y, z per line (mm)", rows=rows))
     fields += [
         field(data, f"{base}.{k}", label, placeholder="filament's")
         for k, label in _SEGMENT_CONTROLS
@@ -248,6 +277,32 @@ def render_form(data: dict[str, Any]) -> list[Any]:
                 ]
             )
         )
+    out.append(
+        html.Details(
+            [
+                html.Summary("nozzle (G-code)"),
+                html.Div(
+                    [field(data, f"nozzle.{k}", label) for k, label in _NOZZLE_FIELDS],
+                    className="grid",
+                ),
+            ],
+            className="filament",
+        )
+    )
+    if data.get("contact") is not None:  # a [contact] table: the simulation's contact model
+        out.append(
+            html.Details(
+                [
+                    html.Summary("contact (simulation)"),
+                    html.Div(
+                        [field(data, f"contact.{k}", label) for k, label in _CONTACT_FIELDS]
+                        + [_choice(data, "contact.branch", "branch", ["lowest", "continuous"])],
+                        className="grid",
+                    ),
+                ],
+                className="filament",
+            )
+        )
     return out
 
 
@@ -283,6 +338,9 @@ def page(sid: str, examples: list[tuple[str, str]], machines: list[tuple[str, st
             dcc.Store(id="drawn", data=-1),
             dcc.Store(id="generation", data=-1),
             dcc.Store(id="inverse-design"),
+            dcc.Store(id="band-request"),
+            dcc.Store(id="band-go"),
+            dcc.Store(id="run-frames"),
             dcc.Interval(id="poll", interval=400, disabled=True),
             html.Header(
                 [

@@ -47,6 +47,21 @@ function(contents, name) {
 }
 """.replace("LIMIT", str(MAX_TOML_BYTES))
 
+# The calibration band of a prediction follows its nominal value: asked for once the design
+# has stood still for BAND_DELAY_MS (a newer edit's request supersedes an older one's).
+BAND_DELAY_MS = 300
+_DEBOUNCE_BAND = """
+function(request) {
+    if (!request) { return window.dash_clientside.no_update; }
+    window.rotomorphBand = request.rev;
+    return new Promise(function(resolve) {
+        setTimeout(function() {
+            resolve(window.rotomorphBand === request.rev
+                ? request : window.dash_clientside.no_update);
+        }, DELAY);
+    });
+}
+""".replace("DELAY", str(BAND_DELAY_MS))
 
 #: What the run view shows, said under it.
 FINAL_CAPTION = "the finished run, read back from its results.h5 (as rotomorph view shows it)"
@@ -133,10 +148,32 @@ def create_app(
         prevent_initial_call=True,
     )
 
+    def shown(data: Any, selected: Any, sid: str) -> tuple[Any, ...]:
+        """design-error, prediction, plan, plan-box style and band request of a re-rendered
+        form (its fields' error lines start empty: an error is said above the form)."""
+        _, error, *rest = _derive(data, selected, [], sessions.files(sid))
+        return (error, *rest)
+
+    derived = (
+        Output("design-error", "children", allow_duplicate=True),
+        Output("prediction", "children", allow_duplicate=True),
+        Output("plan", "figure", allow_duplicate=True),
+        Output("plan-box", "style", allow_duplicate=True),
+        Output("band-request", "data", allow_duplicate=True),
+    )
+
+    app.clientside_callback(
+        _DEBOUNCE_BAND,
+        Output("band-go", "data"),
+        Input("band-request", "data"),
+        prevent_initial_call=True,
+    )
+
     @app.callback(
         Output("design-data", "data"),
         Output("form", "children"),
         Output("upload-error", "children", allow_duplicate=True),
+        *derived,
         Input("example", "value"),
         Input("upload-checked", "data"),
         Input("inverse-open", "n_clicks"),
@@ -145,6 +182,12 @@ def create_app(
         prevent_initial_call="initial_duplicate",
     )
     def load(example: Any, upload: Any, _open: Any, inverse: Any, sid: str) -> Any:
+        out = _load(example, upload, inverse, sid)
+        if out[0] is no_update:
+            return (*out, *[no_update] * len(derived))
+        return (*out, *shown(out[0], None, sid))
+
+    def _load(example: Any, upload: Any, inverse: Any, sid: str) -> tuple[Any, Any, Any]:
         from rotomorph.io.designfile import parse_design_bytes
         from rotomorph.io.tomlfile import decode_toml_bytes
 
@@ -184,31 +227,44 @@ def create_app(
     # ------------------------------------------------------------------ editing
     @app.callback(
         Output("design-data", "data", allow_duplicate=True),
+        Output({"type": "error", "path": ALL}, "children"),
+        *derived,
         Input({"type": "field", "path": ALL}, "value"),
         State({"type": "field", "path": ALL}, "id"),
         State("design-data", "data"),
+        State("selected-edge", "data"),
+        State("sid", "data"),
         prevent_initial_call=True,
     )
-    def edit(values: list[Any], ids: list[dict[str, str]], data: Any) -> Any:
+    def edit(
+        values: list[Any], ids: list[dict[str, str]], data: Any, selected: Any, sid: str
+    ) -> Any:
+        # one request per edit: the edited design, its check and its nominal prediction
+        paths = [o["id"]["path"] for o in ctx.outputs_list[1]]
         if not data or not ids:
-            return no_update
+            return (no_update, [no_update] * len(paths), *[no_update] * len(derived))
         new = data
         for value, id_ in zip(values, ids, strict=True):
-            new = editing.set_field(new, id_["path"], editing.parse_value(value))
-        return new if new != data else no_update
+            new = editing.set_field(new, id_["path"], editing.parse_field(id_["path"], value))
+        if new == data:
+            return (no_update, [no_update] * len(paths), *[no_update] * len(derived))
+        return (new, *_derive(new, selected, paths, sessions.files(sid)))
 
     @app.callback(
         Output("design-data", "data", allow_duplicate=True),
         Output("form", "children", allow_duplicate=True),
+        *derived,
         Input({"type": "seg-add", "fil": ALL, "kind": ALL}, "n_clicks"),
         Input({"type": "seg-remove", "fil": ALL}, "n_clicks"),
         State("design-data", "data"),
+        State("selected-edge", "data"),
+        State("sid", "data"),
         prevent_initial_call=True,
     )
-    def segments(_add: Any, _remove: Any, data: Any) -> Any:
+    def segments(_add: Any, _remove: Any, data: Any, selected: Any, sid: str) -> Any:
         trigger = ctx.triggered_id
         if not isinstance(trigger, dict) or not ctx.triggered[0]["value"]:
-            return no_update, no_update
+            return (no_update, no_update, *[no_update] * len(derived))
         i = int(trigger["fil"])
         fil = data["filaments"][i]
         segs = list(fil.get("segments", []))
@@ -217,45 +273,26 @@ def create_app(
         elif len(segs) > 1:
             segs.pop()
         new = editing.set_field(data, f"filaments[{i}].segments", segs)
-        return new, render_form(new)
+        return (new, render_form(new), *shown(new, selected, sid))
 
     @app.callback(
-        Output({"type": "error", "path": ALL}, "children"),
-        Output("design-error", "children"),
-        Output("prediction", "children"),
-        Output("plan", "figure"),
-        Output("plan-box", "style"),
-        Input("design-data", "data"),
-        State("selected-edge", "data"),
+        Output("prediction", "children", allow_duplicate=True),
+        Input("band-go", "data"),
+        State("design-data", "data"),
+        State("sid", "data"),
+        prevent_initial_call=True,
     )
-    def derive(data: Any, selected: Any) -> Any:
-        from rotomorph.prediction.design import predict_design
-
-        paths = [o["id"]["path"] for o in ctx.outputs_list[0]]
+    def band(request: Any, data: Any, sid: str) -> Any:
+        # the nominal prediction is on the page already: its calibration band, unless a newer
+        # edit came in meanwhile
+        store = sessions.files(sid)
+        if not request or request.get("rev") != store.get("rev"):
+            return no_update
         design, error = editing.check(data or {})
-        errors = ["" for _ in paths]
-        shown = ""
         if error is not None:
-            where = editing.error_field(error[0])
-            if where in paths:
-                errors[paths.index(where)] = error[1]
-            else:
-                shown = error[1]
-            return (
-                errors,
-                shown,
-                [html.Div("prediction waits for a valid design")],
-                no_update,
-                no_update,
-            )
-        pred = predict_design(design)
-        lines = [f"'{pred.name}' at {pred.temperature:g} °C (± calibration band)", *pred.lines()]
-        prediction = [html.Div(line, className="prediction-line") for line in lines]
-        if design.lattice is None:
-            return errors, "", prediction, {}, {"display": "none"}
-        modes = editing.edge_modes(design.lattice)
-        plan = views.lattice_plan(design, modes, selected)
-        return errors, "", prediction, plan, {"display": "block"}
+            return no_update
+        lines = _prediction_lines(design, band=True)
+        return lines if store.get("rev") == request["rev"] else no_update
 
     @app.callback(
         Output("selected-edge", "data"),
@@ -281,18 +318,21 @@ def create_app(
     @app.callback(
         Output("design-data", "data", allow_duplicate=True),
         Output("form", "children", allow_duplicate=True),
+        *derived,
         Input("edge-mode", "value"),
         Input("edge-speed", "value"),
         State("selected-edge", "data"),
         State("design-data", "data"),
+        State("sid", "data"),
         prevent_initial_call=True,
     )
-    def edit_edge(mode: Any, speed: Any, edge: Any, data: Any) -> Any:
+    def edit_edge(mode: Any, speed: Any, edge: Any, data: Any, sid: str) -> Any:
+        nothing = (no_update, no_update, *[no_update] * len(derived))
         if edge is None:
-            return no_update, no_update
+            return nothing
         design, _ = editing.check(data)
         if design is None or design.lattice is None:
-            return no_update, no_update
+            return nothing
         modes = editing.edge_modes(design.lattice)
         speeds = design.lattice.edge_speeds or [design.lattice.speed] * len(modes)
         new_mode = mode if mode != modes[edge] else None
@@ -302,9 +342,9 @@ def create_app(
             else None
         )
         if new_mode is None and new_speed is None:
-            return no_update, no_update
+            return nothing
         new = editing.set_edge(data, modes, edge, mode=new_mode, speed=new_speed)
-        return new, render_form(new)
+        return (new, render_form(new), *shown(new, edge, sid))
 
     # ------------------------------------------------------------------ jobs
     @app.callback(
@@ -435,20 +475,27 @@ def create_app(
     @app.callback(
         Output("run-view", "figure"),
         Output("run-shown", "children"),
+        Output("run-frames", "data"),
         Input("generation", "data"),
+        State("run-frames", "data"),
         State("sid", "data"),
         prevent_initial_call=True,
     )
-    def draw(_generation: Any, sid: str) -> Any:
+    def draw(_generation: Any, shown: Any, sid: str) -> Any:
         # apart from `poll`, so that a slow drawing never holds back the progress shown;
-        # the caption says which figure is shown: the steps streamed so far, or the run's file
+        # the caption says which figure is shown: the steps streamed so far, or the run's file.
+        # While the run streams, only the steps the page lacks are sent (a Patch).
         job = sessions.job(sid)
         if job is None or job.kind != "simulate":
-            return no_update, no_update
+            return no_update, no_update, no_update
         if job.state == "done" and job.result:
-            return views.final_figure(job.result["folder"])[0], FINAL_CAPTION
-        figure = views.stream_figure(job)
-        return (no_update, no_update) if figure is None else (figure, STREAM_CAPTION)
+            return views.final_figure(job.result["folder"])[0], FINAL_CAPTION, None
+        update = views.stream_update(
+            job, shown if isinstance(shown, int) else None, sessions.files(sid)
+        )
+        if update is None:
+            return no_update, no_update, no_update
+        return update[0], STREAM_CAPTION, update[1]
 
     # ------------------------------------------------------------------ files
     @app.callback(
@@ -627,6 +674,51 @@ def _malformed(err: BaseException) -> bool:
         tb = tb.tb_next
     where = Path(tb.tb_frame.f_code.co_filename).as_posix() if tb is not None else ""
     return "/dash/" in where or "/rotomorph/app/" in where
+
+
+def _prediction_lines(design: Any, *, band: bool) -> list[Any]:
+    """The prediction panel's lines: nominal only (``band`` False: the band follows), or
+    with the calibration band, as ``rotomorph predict`` prints them."""
+    from rotomorph.prediction.band import nominal_only
+    from rotomorph.prediction.design import predict_design
+
+    if band:
+        pred = predict_design(design)
+        said = "± calibration band"
+    else:
+        with nominal_only():
+            pred = predict_design(design)
+        said = "nominal; its calibration band follows"
+    lines = [f"'{pred.name}' at {pred.temperature:g} °C ({said})", *pred.lines()]
+    return [html.Div(line, className="prediction-line") for line in lines]
+
+
+def _derive(data: Any, selected: Any, paths: list[str], store: dict[str, Any]) -> tuple[Any, ...]:
+    """What an edit of the design shows, in one answer: the error line of each field in
+    ``paths`` (and the one said above the form), the nominal prediction, the lattice's plan
+    and whether it is shown, and the request for the prediction's band (or no request).
+
+    ``store`` is the session's server-side store: its ``rev`` names the latest design
+    predicted, so that a band asked for an older one is not shown over a newer one.
+    """
+    design, error = editing.check(data or {})
+    errors = ["" for _ in paths]
+    rev = uuid.uuid4().hex
+    store["rev"] = rev
+    if error is not None:
+        where = editing.error_field(error[0])
+        shown = ""
+        if where in paths:
+            errors[paths.index(where)] = error[1]
+        else:
+            shown = error[1]
+        waits = [html.Div("prediction waits for a valid design")]
+        return errors, shown, waits, no_update, no_update, None
+    prediction = _prediction_lines(design, band=False)
+    if design.lattice is None:
+        return errors, "", prediction, {}, {"display": "none"}, {"rev": rev}
+    plan = views.lattice_plan(design, editing.edge_modes(design.lattice), selected)
+    return errors, "", prediction, plan, {"display": "block"}, {"rev": rev}
 
 
 def _cure(text: Any) -> float:

@@ -12,6 +12,7 @@ shows numbers only.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ __all__ = [
     "partial_results",
     "step_verdicts",
     "stream_figure",
+    "stream_update",
     "toolpath_figure",
 ]
 
@@ -199,6 +201,141 @@ def stream_figure(job: Any) -> Any:
     if field != "janus":
         return None
     return _sized(viewer_figure(results, field=field, facets=8))
+
+
+def _frames_from(results: Any, k0: int) -> Any:
+    """``results`` from step ``k0`` on."""
+    from rotomorph.io.results import RunResults
+
+    return RunResults(
+        design=results.design,
+        edges=results.edges,
+        branch=results.branch,
+        positions=results.positions[k0:],
+        scalars={k: v[k0:] for k, v in results.scalars.items()},
+        fields={k: v[k0:] for k, v in results.fields.items()},
+        units=results.units,
+        metadata=results.metadata,
+        static=results.static,
+    )
+
+
+_STEP_OF = re.compile(r"\(step (\d+)/\d+\)")
+
+
+def _retitle(text: str, k0: int, last: int) -> str:
+    """A frame title's ``(step k/n)`` as step ``k0 + k`` of the run's ``last``."""
+    return _STEP_OF.sub(lambda m: f"(step {k0 + int(m.group(1))}/{last})", text, count=1)
+
+
+def _typed(value: Any) -> Any:
+    """``value`` with its numeric arrays as plotly.js's typed-array records (base64, as a
+    figure's own arrays are sent), not as lists of decimal numbers."""
+    from _plotly_utils.utils import to_typed_array_spec
+
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiu":
+        return to_typed_array_spec(value)
+    if isinstance(value, dict):
+        return {k: _typed(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_typed(v) for v in value]
+    return value
+
+
+def _scene_box(ranges: list[list[float]]) -> dict[str, Any]:
+    half = np.array([0.5 * (b - a) for a, b in ranges])
+    ratio = half / float(half.max())
+    return {
+        **{f"{c}axis": {"range": list(r)} for c, r in zip("xyz", ranges, strict=True)},
+        "aspectratio": dict(zip("xyz", (float(v) for v in ratio), strict=True)),
+    }
+
+
+def stream_update(job: Any, shown: int | None, store: dict[str, Any]) -> tuple[Any, int] | None:
+    """What the run view needs of the steps a running simulation has streamed: the run
+    viewer's figure of them all, or a :class:`dash.Patch` that adds to the page's figure only
+    the steps it does not show yet (their frames and slider steps, the tubes of the latest,
+    the title and the box), so that each step costs the server one step's drawing.
+
+    Parameters
+    ----------
+    job
+        The running :class:`~rotomorph.app.jobs.Job`.
+    shown
+        Steps of this job the page's figure holds, as the page says (None: none).
+    store
+        The session's server-side store: what was drawn of which job (its coarse segments,
+        the steps drawn, the box); a page that does not hold what the store says is drawn
+        anew.
+
+    Returns
+    -------
+    tuple or None
+        ``(figure or Patch, steps shown after it)``; None before the first step, when the
+        figure has them all, or for a run without interface normals (no Janus tubes).
+    """
+    from dash import Patch
+
+    from rotomorph.plot.coarsen import coarsen_network
+    from rotomorph.plot.viewer import viewer_figure
+
+    results = partial_results(job)
+    if results is None or "active_normal" not in results.fields:
+        return None
+    s = results.n_steps
+    units = len(job.topology["units"]) if job.topology else 1
+    last = units * (job.steps + 1) - 1  # the run's last frame when it ends
+    key = (id(job), job.started)
+    state = store.get("stream")
+    if state is None or state["key"] != key or shown != state["shown"] or shown is None:
+        radius = float(np.max(results.static["radius"]))
+        network = coarsen_network(results.positions, results.edges, radius)
+        fig = _sized(viewer_figure(results, field="janus", facets=8, network=network))
+        fig.layout.title.text = _retitle(fig.layout.title.text, 0, last)
+        for frame in fig.frames:
+            frame.layout.title.text = _retitle(frame.layout.title.text, 0, last)
+        scene = fig.layout.scene
+        ranges = [list(scene[f"{c}axis"].range) for c in "xyz"]
+        store["stream"] = {"key": key, "network": network, "shown": s, "ranges": ranges}
+        return fig, s
+    if s <= shown:
+        return None
+    part = viewer_figure(
+        _frames_from(results, shown), field="janus", facets=8, network=state["network"]
+    )
+    patch = Patch()
+    tubes = part.data[0]
+    moving = ("x", "y", "z", "intensity") if part.frames[0].data[0].intensity is not None else "xyz"
+    for name in moving:  # the tubes now: the latest step's (the Janus sides' colours stay)
+        patch["data"][0][name] = _typed(np.asarray(tubes[name]))
+    frames = []
+    for i, frame in enumerate(part.frames):
+        record = frame.to_plotly_json()
+        record["name"] = str(shown + i)
+        record["layout"]["title"]["text"] = _retitle(record["layout"]["title"]["text"], shown, last)
+        frames.append(_typed(record))
+    patch["frames"].extend(frames)
+    steps = []
+    for i, step in enumerate(part.layout.sliders[0].steps):
+        record = step.to_plotly_json()
+        record["args"][0] = [str(shown + i)]
+        steps.append(record)
+    patch["layout"]["sliders"][0]["steps"].extend(steps)
+    patch["layout"]["sliders"][0]["active"] = s - 1
+    patch["layout"]["title"]["text"] = _retitle(part.layout.title.text, shown, last)
+    if part.layout.scene.annotations:
+        patch["layout"]["scene"]["annotations"] = [
+            a.to_plotly_json() for a in part.layout.scene.annotations
+        ]
+    new = [list(part.layout.scene[f"{c}axis"].range) for c in "xyz"]
+    ranges = [[min(a[0], b[0]), max(a[1], b[1])] for a, b in zip(state["ranges"], new, strict=True)]
+    if ranges != state["ranges"]:  # the shape left the box: a box around every step so far
+        box = _scene_box(ranges)
+        for c in "xyz":
+            patch["layout"]["scene"][f"{c}axis"]["range"] = box[f"{c}axis"]["range"]
+        patch["layout"]["scene"]["aspectratio"] = box["aspectratio"]
+    state.update(shown=s, ranges=ranges)
+    return patch, s
 
 
 def final_figure(folder: str | Path) -> tuple[Any, Any]:

@@ -29,7 +29,7 @@ from rotomorph.errors import InvalidParameterError
 from rotomorph.io.atomic import atomic_write_text
 from rotomorph.io.results import RunResults
 from rotomorph.io.validity import assess, run_verdict
-from rotomorph.plot.coarsen import coarsen_network
+from rotomorph.plot.coarsen import CoarseNetwork, coarsen_network
 from rotomorph.plot.shapes import scalar_norm
 from rotomorph.plot.tubes import ACTIVE_COLOUR, PASSIVE_COLOUR, tube_mesh
 
@@ -129,7 +129,13 @@ def _per_segment(value: Any, e: int, pick: np.ndarray) -> np.ndarray | float:
     return v[pick] if v.ndim == 1 and len(v) == e else float(np.mean(v))
 
 
-def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8) -> Any:
+def viewer_figure(
+    results: RunResults,
+    *,
+    field: str = "janus",
+    facets: int = 8,
+    network: CoarseNetwork | None = None,
+) -> Any:
     """The plotly figure of :func:`write_viewer`.
 
     Trace 0 holds the tubes (``Mesh3d``: the triangles once, one colour value per triangle),
@@ -139,7 +145,8 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     tube rings turn with the interface normal). Runs of segments much shorter than the tube
     radius are drawn as coarser segments (:func:`~rotomorph.plot.coarsen.coarsen_network`,
     about one radius long, turning by at most 0.2 rad), which no one sees and which keeps the
-    file small.
+    file small. ``network`` gives those coarse segments instead (a figure drawn in parts, such
+    as a run streamed step by step, keeps its first part's: the triangles stay the same).
     """
     go = _plotly()
     names = viewer_fields(results)
@@ -150,7 +157,11 @@ def viewer_figure(results: RunResults, *, field: str = "janus", facets: int = 8)
     s = results.n_steps
     n_fine = len(results.edges)
     fine_radius = _radius(results)
-    coarse = coarsen_network(results.positions, results.edges, float(np.max(fine_radius)))
+    coarse = (
+        network
+        if network is not None
+        else coarsen_network(results.positions, results.edges, float(np.max(fine_radius)))
+    )
     edges, pick = coarse.edges, coarse.middle
     m = len(edges)
     radius = coarse.mean(fine_radius) if isinstance(fine_radius, np.ndarray) else fine_radius

@@ -59,6 +59,7 @@ __all__ = [
     "calibration_fit",
     "calibration_of",
     "nominal_model",
+    "nominal_only",
     "with_band",
 ]
 
@@ -75,6 +76,24 @@ class _FileCalibration:
 
 
 _FILE: ContextVar[_FileCalibration | None] = ContextVar("rotomorph_prediction_file", default=None)
+
+
+_NOMINAL_ONLY: ContextVar[bool] = ContextVar("rotomorph_prediction_nominal_only", default=False)
+
+
+@contextlib.contextmanager
+def nominal_only() -> Iterator[None]:
+    """While held, :func:`with_band` gives nominal values only (every ``sd`` ``None``).
+
+    The band costs one evaluation of the quantity per independent direction of the
+    calibration's posterior on top of the nominal one; a page that shows the nominal value at
+    once and its band a moment later predicts first inside this.
+    """
+    token = _NOMINAL_ONLY.set(True)
+    try:
+        yield
+    finally:
+        _NOMINAL_ONLY.reset(token)
 
 
 def _file_range(materials: Any) -> CalibratedRange:
@@ -230,7 +249,8 @@ def with_band(quantity: Callable[[FilamentModel], FloatArray], units: list[str])
     """
     state = _FILE.get()
     value = np.asarray(quantity(nominal_model()), dtype=float)
-    if state is not None and state.fit is None:  # a file without a stored covariance
+    no_covariance = state is not None and state.fit is None  # a file that stores none
+    if _NOMINAL_ONLY.get() or no_covariance:
         return [Estimate(float(v), None, u) for v, u in zip(value, units, strict=True)]
     fit = calibration_fit()
     with np.errstate(invalid="ignore"):
