@@ -212,3 +212,43 @@ def test_a_taken_port_is_a_one_line_error(capsys):
         assert main(["serve", "--port", str(port), "--no-open", "--examples", str(EXAMPLES)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("rotomorph: error: --host/--port: cannot listen")
+
+
+def test_points_are_typed_as_x_y_z():
+    assert editing.parse_field("filaments[0].start", "1, 2.5 3") == [1, 2.5, 3]
+    assert editing.parse_field("filaments[0].start", "[1, 2, 3]") == [1, 2, 3]
+    assert editing.parse_field("filaments[0].start", "1, x, 3") == "1, x, 3"  # stays text
+    points = editing.parse_field("filaments[0].segments[1].points", "0,0,0\n1, 0, 0; 2 1 0")
+    assert points == [[0, 0, 0], [1, 0, 0], [2, 1, 0]]
+    assert editing.format_value(points) == "0, 0, 0\n1, 0, 0\n2, 1, 0"
+    assert editing.parse_field("filaments[0].speed", "2") == 2  # other fields as before
+    data = _data("composite_rotation")
+    assert editing.set_field(data, "nozzle.diameter", None) is data  # no empty [nozzle] made
+    bad = editing.set_field(data, "filaments[0].start", "1, x, 3")
+    design, error = editing.check(bad)
+    assert design is None and editing.error_field(error[0]) == "filaments[0].start"
+    moved = editing.set_field(data, "filaments[0].start", [5.0, 6.0, 0.0])
+    design, error = editing.check(moved)
+    assert error is None
+    assert list(design.filaments[0].to_program().points[0]) == [5.0, 6.0, 0.0]
+
+
+def _without_sd(record):
+    if isinstance(record, dict):
+        return {k: _without_sd(v) for k, v in record.items() if k != "sd_calibration"}
+    if isinstance(record, list):
+        return [_without_sd(v) for v in record]
+    return record
+
+
+@pytest.mark.parametrize("name", ["composite_rotation", "lattice_dome"])
+def test_the_nominal_prediction_is_the_banded_ones_without_its_band(name):
+    from rotomorph.prediction.band import nominal_only
+    from rotomorph.prediction.design import predict_design
+
+    design, _ = editing.check(_data(name))
+    full = predict_design(design)
+    with nominal_only():
+        quick = predict_design(design)
+    assert "±" in " ".join(full.lines()) and "±" not in " ".join(quick.lines())
+    assert _without_sd(quick.record()) == _without_sd(full.record())

@@ -73,3 +73,21 @@ def test_straight_chain_and_errors() -> None:
 
     with pytest.raises(InvalidDesignError, match="open chain"):
         free_equilibrium(Loop())
+
+
+def _clearance_by_every_pair(x: np.ndarray, exclude_arc: float) -> float:
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))])
+    d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=-1)
+    far = np.abs(s[:, None] - s[None, :]) > exclude_arc
+    return float(d[far].min()) if np.any(far) else float("inf")
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 40, 700])
+def test_min_clearance_is_the_closest_far_pair_of_every_pair(n) -> None:
+    # a noisy helix far from the origin (the squared-distance expansion is taken about the
+    # centroid) against the distance matrix of every pair; rows in several blocks at n = 700
+    rng = np.random.default_rng(n)
+    t = np.linspace(0.0, 20.0, n)
+    x = np.c_[3 * np.cos(t), 3 * np.sin(t), 0.3 * t] + 500.0 + 0.01 * rng.standard_normal((n, 3))
+    for exclude in (0.0, 0.5, 2.0, 30.0, 1e3):
+        assert min_clearance(x, exclude_arc=exclude) == _clearance_by_every_pair(x, exclude)

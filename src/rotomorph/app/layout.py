@@ -255,7 +255,7 @@ def _filament(data: dict[str, Any], i: int, fil: dict[str, Any]) -> Any:
 def render_form(data: dict[str, Any]) -> list[Any]:
     """The form of a design's data: name and description, each filament (its print program
     and segments) or the lattice (geometry, layers, speed, pattern)."""
-    out = [
+    out: list[Any] = [
         html.Div(
             [field(data, "name", "design name"), field(data, "description", "description")],
             className="grid",

@@ -142,6 +142,9 @@ def free_equilibrium(model: object) -> FloatArray:
     )
 
 
+_CLEARANCE_BLOCK = 128  # rows of the distance matrix at once (memory: 128 × N doubles)
+
+
 def min_clearance(points: FloatArray, *, exclude_arc: float) -> float:
     """Smallest distance (mm) between two vertices more than ``exclude_arc`` apart along the
     curve (neighbours along the filament are always close and do not count).
@@ -151,6 +154,22 @@ def min_clearance(points: FloatArray, *, exclude_arc: float) -> float:
     """
     x = np.asarray(points, dtype=float)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))])
-    d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=-1)
-    far = np.abs(s[:, None] - s[None, :]) > exclude_arc
-    return float(d[far].min()) if np.any(far) else float("inf")
+    # arc length grows along the curve: the vertices far from i are j >= first[i] (and those
+    # before i, the same pairs seen from the other end)
+    first = np.searchsorted(s, s + exclude_arc, side="right")
+    rows = np.flatnonzero(first < len(x))
+    if rows.size == 0:
+        return float("inf")
+    c = x - x.mean(axis=0)  # squared distances as |a|² + |b|² - 2 a·b, about the centroid
+    sq = np.einsum("ij,ij->i", c, c)
+    best, pair = np.inf, (0, 0)
+    for a in range(0, rows.size, _CLEARANCE_BLOCK):
+        i = rows[a : a + _CLEARANCE_BLOCK]
+        j0 = int(first[i].min())
+        d2 = sq[i, None] + sq[None, j0:] - 2.0 * (c[i] @ c[j0:].T)
+        d2[np.arange(j0, len(x))[None, :] < first[i][:, None]] = np.inf
+        k = int(np.argmin(d2))
+        if d2.flat[k] < best:
+            best, pair = float(d2.flat[k]), (int(i[k // d2.shape[1]]), j0 + k % d2.shape[1])
+    # the closest pair's distance itself (the expansion above only picks the pair)
+    return float(np.linalg.norm(x[pair[0]] - x[pair[1]]))
