@@ -125,8 +125,12 @@ def test_dome_edit_simulate_and_print(page, server, tmp_path):
         pg.wait_for_function(
             "(p) => document.querySelector('#prediction').innerText != p", arg=_prediction(pg)
         )
+    # the nominal prediction at once, then its calibration band
+    pg.wait_for_function(
+        "document.querySelector('#prediction').innerText.includes('± calibration band')"
+    )
     after = _prediction(pg)
-    assert after != before
+    assert after != before and "±" in after
     area = [float(re.search(r"area ratio ([\d.]+)", t).group(1)) for t in (before, after)]
     assert area[1] > area[0]  # two contracting edges now expand
     pg.wait_for_selector("#plan .scatterlayer")

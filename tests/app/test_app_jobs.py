@@ -96,6 +96,42 @@ def test_a_run_streams_every_step_and_writes_the_clis_files(sessions, tmp_path):
     figure = views.stream_figure(job)
     assert figure is not None and len(figure.frames) == 6
     assert "(step 5/5)" in figure.layout.title.text
+    # drawn as it streams: the first steps whole, then a Patch of the new steps only, which
+    # makes the same frames as the whole figure (the page's figure with it applied)
+    from dataclasses import replace
+
+    store: dict = {}
+    events = job.events
+    early = replace(job, events=[e for e in events if e["kind"] != "step"] + steps[:2])
+    whole, shown = views.stream_update(early, None, store)
+    assert shown == 2 and len(whole.frames) == 2
+    assert "(step 1/5)" in whole.layout.title.text  # the run's last frame when it ends
+    later = replace(early, events=early.events + steps[2:])
+    later.started = early.started
+    store["stream"]["key"] = (id(later), later.started)
+    assert views.stream_update(later, 1, store)[1] == 6  # the page lacks one: drawn whole
+    store["stream"].update(shown=2)
+    patch, shown = views.stream_update(later, 2, store)
+    assert shown == 6 and type(patch).__name__ == "Patch"
+    fig = whole.to_plotly_json()
+    fig["frames"] = [f.to_plotly_json() for f in whole.frames]
+    for op in patch.to_plotly_json()["operations"]:
+        *where, last = op["location"]
+        node = fig
+        for key in where:
+            node = node[key]
+        if op["operation"] == "Extend":
+            node[last].extend(op["params"]["value"])
+        else:
+            assert op["operation"] == "Assign"
+            node[last] = op["params"]["value"]
+    assert [f["name"] for f in fig["frames"]] == [str(k) for k in range(6)]
+    assert [s["args"][0] for s in fig["layout"]["sliders"][0]["steps"]] == [
+        [str(k)] for k in range(6)
+    ]
+    assert "(step 5/5)" in fig["layout"]["title"]["text"]
+    assert "(step 4/5)" in fig["frames"][4]["layout"]["title"]["text"]
+    assert views.stream_update(later, 6, store) is None  # nothing new
     streamed = [e["positions"] for e in steps if e["unit"] == 1]
     np.testing.assert_allclose(streamed[-1], ours.positions[-1][-len(streamed[-1]) :], atol=1e-5)
 

@@ -65,7 +65,7 @@ def parse_value(text: Any) -> Any:
 
 #: Fields holding a point (``x, y, z``) or a list of points (one ``x, y, z`` per line or
 #: separated by ``;``), by the last name of their path (mm).
-POINT_FIELDS = frozenset({"start"})
+POINT_FIELDS = frozenset({"start", "origin"})
 POINT_LIST_FIELDS = frozenset({"points"})
 
 

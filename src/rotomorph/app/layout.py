@@ -75,6 +75,7 @@ _LATTICE_FIELDS = (
     ("layer_height", "layer height (mm)"),
     ("speed", "speed (mm/s)"),
     ("ghost_nodes", "rod nodes per edge"),
+    ("origin", "origin x, y, z (mm)"),
 )
 
 #: Target files the inverse panel starts from (TOML, parsed as ``rotomorph inverse`` parses).

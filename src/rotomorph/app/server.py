@@ -12,6 +12,7 @@ from __future__ import annotations
 import base64
 import binascii
 import logging
+import threading
 import uuid
 from pathlib import Path
 from typing import Any
@@ -130,6 +131,7 @@ def create_app(
     )
     app.layout = lambda: page(uuid.uuid4().hex, example_choices, machine_choices)
     _guard(app.server, allowed_hosts)
+    threading.Thread(target=_import_figures, name="rotomorph-app-imports", daemon=True).start()
 
     def design_of(data: Any) -> Any:
         design, error = editing.check(data or {})
@@ -231,13 +233,19 @@ def create_app(
         *derived,
         Input({"type": "field", "path": ALL}, "value"),
         State({"type": "field", "path": ALL}, "id"),
+        State({"type": "error", "path": ALL}, "children"),
         State("design-data", "data"),
         State("selected-edge", "data"),
         State("sid", "data"),
         prevent_initial_call=True,
     )
     def edit(
-        values: list[Any], ids: list[dict[str, str]], data: Any, selected: Any, sid: str
+        values: list[Any],
+        ids: list[dict[str, str]],
+        shown_errors: list[Any],
+        data: Any,
+        selected: Any,
+        sid: str,
     ) -> Any:
         # one request per edit: the edited design, its check and its nominal prediction
         paths = [o["id"]["path"] for o in ctx.outputs_list[1]]
@@ -248,7 +256,13 @@ def create_app(
             new = editing.set_field(new, id_["path"], editing.parse_field(id_["path"], value))
         if new == data:
             return (no_update, [no_update] * len(paths), *[no_update] * len(derived))
-        return (new, *_derive(new, selected, paths, sessions.files(sid)))
+        errors, *rest = _derive(new, selected, paths, sessions.files(sid))
+        # only the error lines that change are sent (and redrawn)
+        same = len(shown_errors) == len(errors)
+        errors = [
+            no_update if same and (shown_errors[k] or "") == e else e for k, e in enumerate(errors)
+        ]
+        return (new, errors, *rest)
 
     @app.callback(
         Output("design-data", "data", allow_duplicate=True),
@@ -676,6 +690,15 @@ def _malformed(err: BaseException) -> bool:
     return "/dash/" in where or "/rotomorph/app/" in where
 
 
+def _import_figures() -> None:
+    """Import what the first drawings need (plotly's figure classes, the run viewer, the
+    prediction), while the page loads: the first streamed step is then drawn without it."""
+    import plotly.graph_objects  # noqa: F401
+
+    import rotomorph.plot.viewer
+    import rotomorph.prediction.design  # noqa: F401
+
+
 def _prediction_lines(design: Any, *, band: bool) -> list[Any]:
     """The prediction panel's lines: nominal only (``band`` False: the band follows), or
     with the calibration band, as ``rotomorph predict`` prints them."""
@@ -716,7 +739,8 @@ def _derive(data: Any, selected: Any, paths: list[str], store: dict[str, Any]) -
         return errors, shown, waits, no_update, no_update, None
     prediction = _prediction_lines(design, band=False)
     if design.lattice is None:
-        return errors, "", prediction, {}, {"display": "none"}, {"rev": rev}
+        # a filament: the plan stays hidden (and is not drawn again: no work in the browser)
+        return errors, "", prediction, no_update, {"display": "none"}, {"rev": rev}
     plan = views.lattice_plan(design, editing.edge_modes(design.lattice), selected)
     return errors, "", prediction, plan, {"display": "block"}, {"rev": rev}
 
