@@ -164,6 +164,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--no-simulate", action="store_true", help="skip the simulate case")
+    parser.add_argument("--no-edits", action="store_true", help="skip the edit cases")
     args = parser.parse_args()
     chromium = shutil.which("chromium")
     if chromium is None:
@@ -206,10 +207,11 @@ def main() -> None:
             pg.on("requestfinished", lambda r: _answered(r, REQUESTS))
             time.sleep(WARM_S)  # the session's worker warms up as the person starts designing
             values = [f"{v:.2f}" for v in (2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5)]
-            for design, path in (
+            edits = (
                 ("composite_rotation", "filaments[0].speed"),
                 ("lattice_dome", "lattice.amplitude"),
-            ):
+            )
+            for design, path in () if args.no_edits else edits:
                 _open(pg, design)
                 times, bands = [], []
                 EDITS.clear()

@@ -271,14 +271,18 @@ def stream_update(job: Any, shown: int | None, store: dict[str, Any]) -> tuple[A
     Returns
     -------
     tuple or None
-        ``(figure or Patch, steps shown after it)``; None before the first step, when the
-        figure has them all, or for a run without interface normals (no Janus tubes).
+        ``(figure or Patch, steps shown after it)``; None before the first converged step
+        (the printed state alone is not drawn), when the figure has them all, or for a run
+        without interface normals (no Janus tubes).
     """
     from dash import Patch
 
     from rotomorph.plot.coarsen import coarsen_network
     from rotomorph.plot.viewer import viewer_figure
 
+    if all(e["step"] == 0 for e in job.step_events()):
+        return None  # the printed state only (the ghost): drawn with the first converged step,
+        # so that drawing it does not hold up the server as that step arrives
     results = partial_results(job)
     if results is None or "active_normal" not in results.fields:
         return None
