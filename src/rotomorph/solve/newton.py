@@ -259,7 +259,6 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
         #    the exact Hessian was found indefinite, it is retried only after 1, 2, 4, ...
         #    iterations (backoff), so an indefinite phase costs no failed factorizations
         pure = skip_exact == 0
-        bound: float | None = None  # the step bound of d where already computed
         # rotating an unbalanced free body costs work of order |g|: in the end-game a shift of
         # that order (Levenberg–Marquardt with mu ~ |g|, which keeps quadratic convergence)
         # stops those rigid directions from failing the definiteness test (they are projected
@@ -302,30 +301,11 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
                 if tau > 1e12 * tau_unit:
                     status = Status.NOT_FINITE
                     return _result(x, status, it, n_fact, f, res, dec, history)
-            # a nearly null direction (a free body's fall onto a floor it left in the last
-            # step: no contact holds it yet) makes the step huge and the collision-free bound
-            # a sliver of it, so the iteration moves nothing: a larger shift gives that
-            # direction a finite step (Levenberg-Marquardt)
-            sliver = 0
-            while sliver < SLIVER_RETRIES:
-                bound = obj.max_step(x, obj.project(d))  # reused by the line search
-                if bound >= SLIVER_FRACTION:
-                    break
-                bound = None
-                sliver += 1
-                trial_tau = max(10.0 * tau, 1e-8 * tau_unit)
-                n_fact += 1
-                fac_t = factorize(Hc, trial_tau * M)
-                d_t = None if fac_t is None else fac_t.solve(-g)
-                if d_t is None or not np.all(np.isfinite(d_t)):
-                    break
-                tau, fac, d = trial_tau, fac_t, d_t
             shift = tau
             if not convex and tau > opt.curvature_shift * tau_unit:
                 v = _negative_curvature_direction(fac, H, M, g, tau, opt.curvature_iterations)
                 if v is not None:
                     d = d + _scale_curvature_step(obj, x, v, d, M)
-                    bound = None
         d = obj.project(d)
         slope = _dot(g, d)
         dec = -0.5 * slope / escale
@@ -347,7 +327,7 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
             if opt.check_stability and not stall_checked:
                 stall = True  # no decrease left on an indefinite Hessian: a saddle?
                 continue
-        alpha = min(1.0, obj.max_step(x, d) if bound is None else bound)
+        alpha = min(1.0, obj.max_step(x, d))
         accepted = False
         # largest change of an unknown along the step (mm or rad): a nearly singular direction
         # (a free body's fall onto a floor it does not touch yet) makes the shifted step huge,
@@ -399,11 +379,6 @@ def minimize(obj: Objective, x0: FloatArray, options: NewtonOptions | None = Non
     floor = _residual_floor(obj) / fscale
     return _result(x, status, it, n_fact, f, res, dec, history, spec, escapes, floor)
 
-
-#: Larger shifts (x10 each) tried for a shifted step whose collision-free bound is below
-#: :data:`SLIVER_FRACTION` of it (a nearly null direction; see the loop)
-SLIVER_RETRIES = 6
-SLIVER_FRACTION = 1e-6
 
 #: Longest extension of a creeping whole step (a factor of 2 per energy evaluation)
 MAX_EXTENSION = 8.0
