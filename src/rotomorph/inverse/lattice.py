@@ -720,6 +720,12 @@ def _same_strength(
     return np.interp(wanted, strength, grid)
 
 
+def _lifted(check: _Check, lattice: Lattice) -> bool:
+    """The verified state has risen off the printed plane by more than a filament diameter."""
+    z = np.asarray(check.result.positions)[:, 2]
+    return float(np.ptp(z)) > 2.0 * lattice.radius
+
+
 #: Judgements of a design (its first and the restarts from the judge's verified branch).
 JUDGE_ROUNDS = 3
 
@@ -973,6 +979,65 @@ def design_lattice(
         if nodes == "branch"
         else np.arange(lattice.network.n_nodes)
     )
+    history: list[float] = []
+    nit = 0
+    counted = [0]  # solves of the equilibria objects no longer in use
+    judgements = [0]
+    judged: list[tuple[FloatArray, FloatArray, _Check, BathCheck]] = []
+
+    def designed(
+        modes: FloatArray,
+        speeds: FloatArray,
+        check: _Check,
+        verdict: BathCheck | None,
+        relaxed: FloatArray,
+    ) -> LatticeDesign:
+        final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
+        rms = float(np.sqrt(2.0 * j)) * size
+        printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
+        return LatticeDesign(
+            lattice=printed,
+            relaxed=relaxed,
+            modes=modes,
+            speeds=speeds,
+            positions=final.positions,
+            target=target,
+            objective_history=np.array(history),
+            misfit_rms=rms,
+            misfit_rel=rms / size,
+            achieved_gaussian_curvature=float(fit.gaussian_curvature),
+            target_gaussian_curvature=target.gaussian_curvature,
+            stable=stable,
+            iterations=nit,
+            solves=counted[0] + eq.solves,
+            bath=verdict,
+            judge_rounds=judgements[0],
+        )
+
+    if judge is not None and speed_range is not None:
+        # the starting pattern, printable, judged first: the judge's verified state is where
+        # the optimiser's solves start (the branch the judge takes), and a start the judge
+        # already finds reached is returned as it is (the simplest design: one speed per edge
+        # as given, no optimisation)
+        modes0 = np.where(c0 >= 0, 1.0, -1.0)
+        speeds0 = _printable_speeds(np.clip(v0, *speed_range), speed_range, speed_resolution)
+        verdict0 = judge(with_settings(lattice, modes0, speeds0))
+        judgements[0] += 1
+        state0 = verdict0.result.states[-1]
+
+        def from_start(p: FloatArray, state: State = state0) -> State:
+            return state
+
+        if lifting:
+            heated = from_start
+            eq = _Equilibria(blend, seed=seed, env=env, heated=heated)
+        if verdict0.reached:
+            p_start = np.concatenate([modes0, speeds0])
+            check0 = _verify(
+                blend, p_start, seed, target, picked, size, lattice, env=env, heated=from_start
+            )
+            counted[0] += check0.solves
+            return designed(modes0, speeds0, check0, verdict0, p_start)
     if speed_range is None:
         v_bounds = [(float(v), float(v)) for v in v0]
     else:
@@ -995,11 +1060,16 @@ def design_lattice(
             for v in starts
         ]
         eq.solves += sum(t.solves for t in tried0)
-        k0 = min(range(len(starts)), key=lambda i: (not tried0[i].stable, tried0[i].misfit))
+        order: list[int] = list(range(len(starts)))
+        if heated is not None and target.gaussian_curvature is not None:
+            # a curved target is not reached from the flat resting state the floor holds a
+            # weak design in (the descent on that branch is blind): start from the lifted
+            # candidates where any is stable
+            lifted = [i for i in order if tried0[i].stable and _lifted(tried0[i], lattice)]
+            order = lifted or order
+        k0 = min(order, key=lambda i: (not tried0[i].stable, tried0[i].misfit))
         v0 = starts[k0]
-    history: list[float] = []
     weight = [printability]
-    counted = [0]  # solves of the equilibria objects no longer in use
 
     def fun(p: FloatArray) -> tuple[float, FloatArray]:
         try:
@@ -1129,17 +1199,17 @@ def design_lattice(
         return speeds, check, its
 
     start_p, start_state = best, best_res.state
-    judged: list[tuple[FloatArray, _Check, BathCheck]] = []
     while True:
         speeds, check, its = refine(start_p, start_state)
         nit += its
         if judge is None:
             break
         verdict = judge(with_settings(lattice, modes, speeds if speed_range is not None else None))
-        judged.append((speeds, check, verdict))
+        judged.append((modes, speeds, check, verdict))
+        judgements[0] += 1
         logger.info(
             "judgement %d: verified K = %.4g 1/mm² (error %s), optimiser's K = %.4g; %s",
-            len(judged),
+            judgements[0],
             verdict.gaussian_curvature,
             "n/a" if verdict.error_rel is None else f"{100 * verdict.error_rel:.1f} %",
             float(check.fit.gaussian_curvature),
@@ -1160,25 +1230,5 @@ def design_lattice(
         start_p, start_state = np.concatenate([modes, speeds]), branch_state
     verdict_kept: BathCheck | None = None
     if judged:
-        speeds, check, verdict_kept = min(judged, key=lambda t: _verdict_rank(t[2]))
-    final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
-    rms = float(np.sqrt(2.0 * j)) * size
-    printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
-    return LatticeDesign(
-        lattice=printed,
-        relaxed=relaxed,
-        modes=modes,
-        speeds=speeds,
-        positions=final.positions,
-        target=target,
-        objective_history=np.array(history),
-        misfit_rms=rms,
-        misfit_rel=rms / size,
-        achieved_gaussian_curvature=float(fit.gaussian_curvature),
-        target_gaussian_curvature=target.gaussian_curvature,
-        stable=stable,
-        iterations=nit,
-        solves=counted[0] + eq.solves,
-        bath=verdict_kept,
-        judge_rounds=len(judged),
-    )
+        modes, speeds, check, verdict_kept = min(judged, key=lambda t: _verdict_rank(t[3]))
+    return designed(modes, speeds, check, verdict_kept, relaxed)
