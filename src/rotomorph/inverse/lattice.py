@@ -912,12 +912,16 @@ def design_lattice(
     judge
         ``judge(printed) -> BathCheck``: the verification the design must pass, e.g.
         :func:`rotomorph.inverse.bath.verify_in_bath` (``simulate``'s own ramp with its lift
-        probe). After phase (5) the printable design is judged; where the verdict is not
-        *reached* (its ramp ended on another branch than the optimiser's, or off the target),
-        phases (3)-(5) run again from the state the judge verified, every fresh solve
-        starting there, up to :data:`JUDGE_ROUNDS` judgements in all. The design returned is
-        the best judged one (reached first; then stable and admissible; then by the verified
-        K's error) and ``bath`` is its verdict.
+        probe). With a speed range, the starting pattern (modes ±1, the lattice's own speeds
+        rounded) is judged first: on the lowest branch every fresh solve then starts from the
+        state the judge verified, and a start judged reached is returned as it is (no
+        optimisation). After phase (5) the printable design is judged; where the verdict is
+        not *reached* (its ramp ended on another branch than the optimiser's, or off the
+        target), phases (3)-(5) run again from the state the judge verified, every fresh
+        solve starting there, up to :data:`JUDGE_ROUNDS` judgements of optimised designs. The
+        design returned is the best judged optimised one (reached first; then stable and
+        admissible; then by the verified K's error) and ``bath`` is its verdict;
+        ``judge_rounds`` counts every judgement.
 
     Notes
     -----
