@@ -20,14 +20,17 @@ ramp ``rotomorph simulate`` runs on the design file (``heat_lattice``, its lift 
 (interpenetrating layer pairs of the printed stack in it; null where the check is not
 available, then ``min_clearance_diameters``), ``stable``, ``admissible``, ``reached`` and
 ``reason`` (with the measures when not reached: K without the weight, the weight-to-bending
-ratio, the rise off the floor), the calibration band ``gaussian_curvature_sd_calibration``,
-``cpu_s`` (the design, its verification and its band) and ``load_1min``.
+ratio, the rise off the floor), ``judge_rounds`` (judgements by that ramp: the optimiser
+restarts from the branch it verified until reached, up to three), the band
+(``gaussian_curvature_sd_calibration``, ``gaussian_curvature_sd_nuisance`` with the
+``nuisance_samples``' K, and ``band`` in words), ``cpu_s`` (the design, its verifications and
+its band) and ``load_1min``.
 
 Targets: filament cases ≤ 5 s (the material response table is built once per session and
 reported separately as ``response-table``), 5 × 5 lattice cases ≤ 60 s on one core, bath cases
 |K| within 10 % of the target with every verified state admissible, ≤ 120 s CPU each.
 
-Run: ``python benchmarks/inverse.py [--quick] [--bath-only]``.
+Run: ``python benchmarks/inverse.py [--quick] [--bath-only] [--bath-case dome|saddle]``.
 """
 
 from __future__ import annotations
@@ -156,7 +159,10 @@ def bath_case(name: str, pattern: str, target, iterations: int) -> None:  # type
         optimised_gaussian_curvature=des.optimised_gaussian_curvature,
         gaussian_curvature_error_rel=check.error_rel,
         gaussian_curvature_sd_calibration=band.gaussian_curvature_sd,
+        gaussian_curvature_sd_nuisance=band.gaussian_curvature_sd_nuisance,
+        nuisance_samples=[float(k) for k in band.nuisance_samples],
         band=band.text(),
+        judge_rounds=des.judge_rounds,
         rms_error_rel=des.misfit_rel,
         stack_overlaps=check.stack_overlaps,
         min_clearance_diameters=check.min_clearance,
@@ -177,11 +183,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer optimiser iterations")
     parser.add_argument("--bath-only", action="store_true", help="only the bath cases")
+    parser.add_argument(
+        "--bath-case", choices=("dome", "saddle"), help="only this bath case (implies --bath-only)"
+    )
     args = parser.parse_args()
     its = 6 if args.quick else 20
-    if args.bath_only:
-        bath_case("lattice-dome-bath", "dome", dome(0.07), its)
-        bath_case("lattice-saddle-bath", "saddle", saddle(0.07), its)
+    if args.bath_only or args.bath_case:
+        if args.bath_case in (None, "dome"):
+            bath_case("lattice-dome-bath", "dome", dome(0.07), its)
+        if args.bath_case in (None, "saddle"):
+            bath_case("lattice-saddle-bath", "saddle", saddle(0.07), its)
         return
     t0 = time.perf_counter()
     table = response_table(max_omega_star=1.5)

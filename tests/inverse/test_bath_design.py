@@ -135,3 +135,92 @@ def test_robust_design_minimises_the_expected_error_and_says_what_it_gives_up():
         )
     assert des.achieved_gaussian_curvature == des.bath.gaussian_curvature
     assert set(choice.record()) >= {"strength_scale", "gives_up_nominally"}
+
+
+@pytest.mark.slow
+def test_the_judge_restarts_the_optimiser_on_its_branch_and_never_passes_an_overlap(
+    monkeypatch,
+):
+    """With a judge (simulate's ramp) whose every verdict interpenetrates, the starting
+    pattern and JUDGE_ROUNDS optimised designs are judged and none is reached; the solves
+    after each judgement start from the state that verdict verified; the design returned is
+    the best judged optimised one, with its verdict."""
+    from rotomorph.contact import Contact
+    from rotomorph.inverse import lattice as lattice_module
+    from rotomorph.inverse.environment import _program
+    from rotomorph.inverse.lattice import JUDGE_ROUNDS, _verdict_rank, design_lattice
+    from rotomorph.lattice.admissibility import lattice_stack
+
+    lat = sinusoidal_lattice(
+        n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
+    )
+    target = dome(0.1)
+    monkeypatch.setattr(bath_module, "_overlaps", lambda res: 3)
+    verdicts = []
+
+    def judge(printed):
+        v = verify_in_bath(printed, target.gaussian_curvature, diagnose=False)
+        verdicts.append((np.asarray(printed.edge_speeds, dtype=float), v))
+        return v
+
+    starts = []
+
+    class Spy(lattice_module._Equilibria):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            starts.append((len(verdicts), self.heated))
+
+    monkeypatch.setattr(lattice_module, "_Equilibria", Spy)
+    des = design_lattice(
+        lat,
+        target,
+        actuation=_program(175.0),
+        contact=Contact(radius=lat.radius, self_contact=True, stack=lattice_stack(lat)),
+        floor=True,
+        gravity=lattice_buoyancy(lat)(175.0),
+        branch="lowest",
+        max_iterations=2,
+        judge=judge,
+    )
+    assert des.judge_rounds == len(verdicts) == 1 + JUDGE_ROUNDS
+    assert all(not v.reached and not v.admissible for _, v in verdicts)
+    assert des.reached is False and des.bath is not None and not des.bath.admissible
+    kept = min(verdicts[1:], key=lambda t: _verdict_rank(t[1]))
+    assert des.bath is kept[1] and np.array_equal(des.speeds, kept[0])
+    # after judgement k, the solves start from the state that verdict verified
+    for k in range(1, len(verdicts)):
+        after = [heated for n, heated in starts if n == k]
+        assert after, f"no restart after judgement {k}"
+        p = np.concatenate([des.modes, des.speeds])
+        assert all(h is not None and h(p) is verdicts[k - 1][1].result.states[-1] for h in after)
+
+
+def test_a_start_the_judge_finds_reached_is_returned_as_it_is():
+    """The starting pattern is judged first: asked for the K its own ramp gives, the design
+    is that pattern at its own (printable) speeds, reached, with no optimiser iteration."""
+    from rotomorph.contact import Contact
+    from rotomorph.inverse.environment import _program
+    from rotomorph.inverse.lattice import SurfaceTarget, design_lattice
+    from rotomorph.lattice.admissibility import lattice_stack
+
+    lat = sinusoidal_lattice(
+        n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
+    )
+    modes = np.array([1.0 if m == "expanding" else -1.0 for m in lat.edge_mode])
+    own = verify_in_bath(with_settings(lat, modes, lat.speeds), None, diagnose=False)
+    k = own.gaussian_curvature
+    base = dome(float(np.sqrt(k)))
+    target = SurfaceTarget("dome", base.height, k, "own K")
+    des = design_lattice(
+        lat,
+        target,
+        actuation=_program(175.0),
+        contact=Contact(radius=lat.radius, self_contact=True, stack=lattice_stack(lat)),
+        floor=True,
+        gravity=lattice_buoyancy(lat)(175.0),
+        branch="lowest",
+        judge=lambda printed: verify_in_bath(printed, k, diagnose=False),
+    )
+    assert des.reached and des.judge_rounds == 1 and des.iterations == 0
+    assert np.array_equal(des.modes, modes) and np.allclose(des.speeds, lat.speeds)
+    assert des.bath is not None and des.bath.error_rel == pytest.approx(0.0, abs=1e-9)

@@ -3,11 +3,13 @@ r"""Lattice designs made, verified and bounded in the surroundings the design de
 :func:`design_in_bath` optimises a lattice design with the physics ``rotomorph simulate``
 applies to its design file (:func:`rotomorph.inverse.lattice.design_lattice` with self-contact,
 the bath floor and the buoyant weight in the hot bath, on the branch ``simulate``'s lift probe
-takes), verifies the printable result with ``simulate``'s own ramp
-(:func:`rotomorph.inverse.bath.verify_in_bath`), scans its overall bending strength with that
-ramp as the judge (:data:`BATH_SCALES`: the optimiser continues one lifted state while
-``simulate`` lifts every design afresh, and K is what they disagree on) and bounds its shape
-by the calibration (:func:`design_band`).
+takes) and has ``simulate``'s own ramp (:func:`rotomorph.inverse.bath.verify_in_bath`) judge
+it: where that ramp's verified state is on another branch than the optimiser's, or off the
+target, the optimiser starts again from the state the ramp verified (``design_lattice``'s
+``judge``, up to :data:`~rotomorph.inverse.lattice.JUDGE_ROUNDS` judgements). Only a design
+still not reached then has its overall bending strength scanned with that ramp as the judge
+(:data:`BATH_SCALES`). Its shape is bounded by the calibration and the nuisance inputs
+(:func:`design_band`).
 
 The band
 --------
@@ -17,9 +19,13 @@ independent direction of its covariance (:meth:`rotomorph.materials.inference.Fi
 as :mod:`rotomorph.prediction.band` does for filaments). The band's standard deviation of any
 output is that of the central secants, :math:`\sigma^2 = \sum_k ((y_k^+ - y_k^-)/2)^2`; the
 nominal value is the verified one (the package's default materials model, which ``simulate``
-uses). The band is the calibration's only: the lattice's geometry (spacing, amplitude), the
-bath's density and the printed stack are taken as given. The sigma-point solves follow the
-verified branch continuously (no lift probe) and are frictionless.
+uses). The nuisance inputs a printed design leaves open (:data:`DESIGN_NUISANCE`: the inks'
+mean density and the bath oil's, which set the buoyant weight, and the active ink's T_NI,
+with the priors of :mod:`rotomorph.simulate.nuisance`) add :data:`NUISANCE_SAMPLES`
+Latin-hypercube samples, whose sample standard deviation is reported beside the calibration's;
+the design's geometry (spacing, amplitude, filament width) and the printed stack are its own.
+Every band solve follows the verified branch continuously (no lift probe) and is
+frictionless.
 
 Robust designs
 --------------
@@ -36,7 +42,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
@@ -76,6 +82,8 @@ from rotomorph.solve.static import solve_static
 
 __all__ = [
     "BATH_SCALES",
+    "DESIGN_NUISANCE",
+    "NUISANCE_SAMPLES",
     "ROBUST_SCALES",
     "DesignBand",
     "RobustChoice",
@@ -87,6 +95,13 @@ __all__ = [
 ROBUST_SCALES = (0.85, 0.92, 1.0, 1.08, 1.16)
 
 _BAND_OPTIONS = NewtonOptions(rtol=1e-8, max_iterations=300)
+
+#: Nuisance inputs (:data:`rotomorph.simulate.nuisance.NUISANCE_PRIORS`) a printed design
+#: leaves open: its geometry (spacing, amplitude, filament width) is the design's own.
+DESIGN_NUISANCE = ("filament_density", "bath_density", "transition")
+
+#: Latin-hypercube samples of :data:`DESIGN_NUISANCE` in a design's band.
+NUISANCE_SAMPLES = 3
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,9 +119,14 @@ class DesignBand:
     directions
         Independent directions of the calibration covariance used (p).
     failed
-        Sigma-point solves that did not converge.
+        Sigma-point and nuisance-sample solves that did not converge.
     cpu_s
         Process CPU time of the band (s).
+    nuisance_samples
+        K at each Latin-hypercube sample of the nuisance inputs (:data:`DESIGN_NUISANCE`;
+        NaN: failed; empty: not sampled).
+    gaussian_curvature_sd_nuisance
+        Sample standard deviation of ``nuisance_samples`` (1/mm²; NaN with fewer than two).
     """
 
     gaussian_curvature: float
@@ -115,13 +135,22 @@ class DesignBand:
     directions: int
     failed: int
     cpu_s: float
+    nuisance_samples: FloatArray = field(default_factory=lambda: np.zeros(0))
+    gaussian_curvature_sd_nuisance: float = float("nan")
 
     def text(self) -> str:
-        """``K = 4.9e-03 ± 3.1e-04 1/mm² (calibration)``."""
-        return (
+        """``K = 4.9e-03 ± 3.1e-04 1/mm² (calibration band) ± 2e-04 (nuisance, 3 samples)``."""
+        out = (
             f"K = {self.gaussian_curvature:.3g} ± {self.gaussian_curvature_sd:.2g} 1/mm² "
             "(calibration band)"
         )
+        if len(self.nuisance_samples):
+            out += (
+                f" ± {self.gaussian_curvature_sd_nuisance:.2g} (nuisance: "
+                f"{len(self.nuisance_samples)} Latin-hypercube samples of "
+                f"{', '.join(DESIGN_NUISANCE)})"
+            )
+        return out
 
     def record(self) -> dict[str, Any]:
         """JSON-ready form."""
@@ -134,9 +163,13 @@ class DesignBand:
             "gaussian_curvature_sd_calibration": num(self.gaussian_curvature_sd),
             "sigma_points": [num(float(k)) for k in self.sigma_points],
             "directions": self.directions,
+            "nuisance_inputs": list(DESIGN_NUISANCE),
+            "nuisance_samples": [num(float(k)) for k in self.nuisance_samples],
+            "gaussian_curvature_sd_nuisance": num(self.gaussian_curvature_sd_nuisance),
             "failed_solves": self.failed,
-            "band_of": "the calibration's posterior (geometry, bath density and the printed "
-            "stack as given); sigma-point solves continue the verified branch, frictionless",
+            "band_of": "the calibration's posterior and the nuisance inputs' priors (the "
+            "design's geometry and the printed stack as given); every solve continues the "
+            "verified branch, frictionless",
             "cpu_s": round(self.cpu_s, 3),
         }
 
@@ -237,17 +270,56 @@ def _sigma_values(
     return np.asarray(out), failed
 
 
+def _nuisance_values(
+    lattice: Lattice, check: BathCheck, temperature: float, contact_model: Any, count: int
+) -> tuple[FloatArray, int]:
+    """K at ``count`` Latin-hypercube samples of :data:`DESIGN_NUISANCE` (the active ink's
+    T_NI, the inks' and the bath's densities setting the weight), each solved warm-started
+    from the verified state with the package's materials model."""
+    from rotomorph.simulate.nuisance import latin_hypercube
+    from rotomorph.simulate.nuisance_lattices import sample_buoyancy, transition_material
+
+    res = check.result
+    contact = None if res.contact is None else replace(res.contact, friction=0.0)
+    out = []
+    failed = 0
+    for sample in latin_hypercube(count, seed=0):
+        lat = replace(lattice, active_material=transition_material(sample.transition))
+        loads = None
+        if contact_model.gravity:
+            loads = Loads(gravity=sample_buoyancy(lat, sample)(temperature))
+        try:
+            out.append(_heated_k(lat, None, temperature, res.states[-1], contact, loads))
+        except ConvergenceError:
+            out.append(float("nan"))
+            failed += 1
+    return np.asarray(out), failed
+
+
 def design_band(
-    lattice: Lattice, check: BathCheck, contact: Any = None, *, temperature: float = 175.0
+    lattice: Lattice,
+    check: BathCheck,
+    contact: Any = None,
+    *,
+    temperature: float = 175.0,
+    nuisance_samples: int = NUISANCE_SAMPLES,
 ) -> DesignBand:
-    """The calibration band of the printed ``lattice``'s verified state ``check`` (module
-    docstring), in the surroundings ``contact`` (a design file's ``[contact]`` table; default
-    the bath)."""
+    """The band of the printed ``lattice``'s verified state ``check`` (module docstring):
+    the calibration's sigma points and ``nuisance_samples`` Latin-hypercube samples of
+    :data:`DESIGN_NUISANCE` (0: none), in the surroundings ``contact`` (a design file's
+    ``[contact]`` table; default the bath)."""
     contact = bath_contact() if contact is None else contact
     c0 = time.process_time()
     ks, failed = _sigma_values(lattice, check, temperature, contact)
     pairs = ks.reshape(-1, 2)
     sd = float(np.sqrt(np.sum((0.5 * (pairs[:, 0] - pairs[:, 1])) ** 2)))
+    nk = np.zeros(0)
+    sd_n = float("nan")
+    if nuisance_samples:
+        nk, n_failed = _nuisance_values(lattice, check, temperature, contact, nuisance_samples)
+        failed += n_failed
+        finite = nk[np.isfinite(nk)]
+        sd_n = float(np.std(finite, ddof=1)) if len(finite) >= 2 else float("nan")
     return DesignBand(
         gaussian_curvature=check.gaussian_curvature,
         gaussian_curvature_sd=sd,
@@ -255,6 +327,8 @@ def design_band(
         directions=len(pairs),
         failed=failed,
         cpu_s=time.process_time() - c0,
+        nuisance_samples=nk,
+        gaussian_curvature_sd_nuisance=sd_n,
     )
 
 
@@ -313,19 +387,6 @@ def design_in_bath(
             self_contact=bool(contact.self_contact),
             stack=lattice_stack(lattice),
         )
-    des = design_lattice(
-        lattice,
-        target,
-        actuation=_program(temperature, filament_model),
-        contact=touch,
-        floor=floor,
-        gravity=gravity,
-        branch=str(contact.branch) if gravity is not None else "continuous",  # type: ignore[arg-type]
-        speed_range=speed_range,
-        speed_resolution=speed_resolution,
-        **options,
-    )
-    des = replace(des, optimised_gaussian_curvature=des.achieved_gaussian_curvature)
     k_t = target.gaussian_curvature
     scan = k_t is not None and speed_range is not None
     verify = partial(
@@ -336,10 +397,27 @@ def design_in_bath(
         filament_model=filament_model,
         materials=materials,
     )
-    check = verify(des.lattice, k_t, diagnose=not scan)
-    if scan:
+    des = design_lattice(
+        lattice,
+        target,
+        actuation=_program(temperature, filament_model),
+        contact=touch,
+        floor=floor,
+        gravity=gravity,
+        branch=str(contact.branch) if gravity is not None else "continuous",  # type: ignore[arg-type]
+        speed_range=speed_range,
+        speed_resolution=speed_resolution,
+        judge=partial(verify, target_gaussian_curvature=k_t, diagnose=False),
+        **options,
+    )
+    des = replace(des, optimised_gaussian_curvature=des.achieved_gaussian_curvature)
+    check = des.bath
+    assert check is not None  # the judge ran
+    if scan and not check.reached:
         assert speed_range is not None
         des, check = _bath_scan(des, check, verify, speed_range, speed_resolution)
+    elif not check.reached:  # the measures of an unreached target
+        check = verify(des.lattice, k_t)
     des = _verified(des, check, options.get("nodes", "branch"))
     calibrated = filament_model is None
     if band and calibrated:

@@ -35,6 +35,8 @@ minimum is rejected by the line search (its objective is infinite).
 
 from __future__ import annotations
 
+import logging
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Literal
@@ -42,7 +44,6 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from scipy.interpolate import RectBivariateSpline
 from scipy.optimize import least_squares, minimize
-from scipy.spatial.transform import Rotation
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.analysis.curvature import fit_quadratic_surface
@@ -86,6 +87,8 @@ __all__ = [
 
 if TYPE_CHECKING:
     from rotomorph.inverse.environment import DesignBand, RobustChoice
+
+logger = logging.getLogger(__name__)
 
 SOLVE_OPTIONS = NewtonOptions(rtol=1e-10, max_iterations=300)
 
@@ -217,10 +220,36 @@ def rigid_motion(params: FloatArray, x: FloatArray) -> FloatArray:
     ``params = (a, b, γ, dz)``: a swing about a horizontal axis (rotation vector ``(a, b, 0)``,
     rad) then a twist about z (rad). Every rotation is such a product, and the twist stays a
     well-scaled coordinate however far it turns (a rotation vector does not)."""
-    rot = Rotation.from_euler("z", params[2]) * Rotation.from_rotvec([params[0], params[1], 0.0])
-    y = rot.apply(x)
+    y = np.asarray(x, dtype=float) @ _alignment_rotation(params).T
     y[:, 2] += params[3]
     return y
+
+
+def _alignment_rotation(params: FloatArray) -> FloatArray:
+    """The rotation matrix ``Rz(γ) · R(a, b, 0)`` of :func:`rigid_motion` (Rodrigues' formula
+    for the swing; written out because the misfit's alignment evaluates it hundreds of times
+    per design, where building rotation objects dominated the cost)."""
+    a, b, gamma = float(params[0]), float(params[1]), float(params[2])
+    theta = math.hypot(a, b)
+    if theta > 0.0:
+        ka, kb = a / theta, b / theta
+        sn, vc = math.sin(theta), 1.0 - math.cos(theta)
+    else:
+        ka = kb = sn = vc = 0.0
+    # R = I + sin θ K + (1 − cos θ) K² for the unit axis (ka, kb, 0)
+    swing = [
+        [1.0 - vc * kb * kb, vc * ka * kb, sn * kb],
+        [vc * ka * kb, 1.0 - vc * ka * ka, -sn * ka],
+        [-sn * kb, sn * ka, 1.0 - vc],
+    ]
+    c, s = math.cos(gamma), math.sin(gamma)
+    return np.array(
+        [
+            [c * swing[0][j] - s * swing[1][j] for j in range(3)],
+            [s * swing[0][j] + c * swing[1][j] for j in range(3)],
+            swing[2],
+        ]
+    )
 
 
 def surface_misfit(
@@ -275,7 +304,7 @@ def surface_misfit(
     r = (y[:, 2] - z) / size
     j = 0.5 * float(r @ r) / n
     dr_dy = np.stack([-zx, -zy, np.ones(n)], axis=1) / size
-    rot = (Rotation.from_euler("z", p[2]) * Rotation.from_rotvec([p[0], p[1], 0.0])).as_matrix()
+    rot = _alignment_rotation(p)
     per_node = (r[:, None] * dr_dy) @ rot / n
     grad = per_node - per_node.mean(axis=0)
     return j, grad, p
@@ -532,6 +561,8 @@ class LatticeDesign:
         With ``bath``: K of the optimiser's own verified equilibrium of the design it returned
         (1/mm²), before ``simulate``'s ramp judged it (the two differ where that ramp lifts the
         design onto another branch).
+    judge_rounds
+        Judgements made by :func:`design_lattice`'s ``judge`` (0: none).
     """
 
     lattice: Lattice
@@ -552,6 +583,7 @@ class LatticeDesign:
     band: DesignBand | None = None
     robust: RobustChoice | None = None
     optimised_gaussian_curvature: float | None = None
+    judge_rounds: int = 0
 
     @property
     def reached(self) -> bool | None:
@@ -688,6 +720,23 @@ def _same_strength(
     return np.interp(wanted, strength, grid)
 
 
+def _lifted(check: _Check, lattice: Lattice) -> bool:
+    """The verified state has risen off the printed plane by more than a filament diameter."""
+    z = np.asarray(check.result.positions)[:, 2]
+    return float(np.ptp(z)) > 2.0 * lattice.radius
+
+
+#: Judgements of a design (its first and the restarts from the judge's verified branch).
+JUDGE_ROUNDS = 3
+
+
+def _verdict_rank(check: BathCheck) -> tuple[bool, bool, float]:
+    """Reached first; then stable and admissible; then by the verified K's relative error."""
+    good = bool(check.stable) and check.admissible
+    err = np.inf if check.error_rel is None else float(check.error_rel)
+    return (not check.reached, not good, err)
+
+
 #: Uniform speeds (geometrically spaced over the range) the starting pattern is tried at.
 INITIAL_SPEEDS = 5
 
@@ -813,6 +862,7 @@ def design_lattice(
     floor: bool | Floor = False,
     gravity: Gravity | None = None,
     branch: Literal["continuous", "lowest"] = "continuous",
+    judge: Callable[[Lattice], BathCheck] | None = None,
 ) -> LatticeDesign:
     """Choose per-edge modes and print speeds that make ``lattice`` rise into ``target``.
 
@@ -859,6 +909,19 @@ def design_lattice(
         lowest-energy ramp (its lift probe) of the design's printable rounding (modes ±1, the
         same speeds) in the same surroundings, with its floor, so the optimiser works on the
         branch ``simulate`` takes; the adjoint then differentiates that equilibrium.
+    judge
+        ``judge(printed) -> BathCheck``: the verification the design must pass, e.g.
+        :func:`rotomorph.inverse.bath.verify_in_bath` (``simulate``'s own ramp with its lift
+        probe). With a speed range, the starting pattern (modes ±1, the lattice's own speeds
+        rounded) is judged first: on the lowest branch every fresh solve then starts from the
+        state the judge verified, and a start judged reached is returned as it is (no
+        optimisation). After phase (5) the printable design is judged; where the verdict is
+        not *reached* (its ramp ended on another branch than the optimiser's, or off the
+        target), phases (3)-(5) run again from the state the judge verified, every fresh
+        solve starting there, up to :data:`JUDGE_ROUNDS` judgements of optimised designs. The
+        design returned is the best judged optimised one (reached first; then stable and
+        admissible; then by the verified K's error) and ``bath`` is its verdict;
+        ``judge_rounds`` counts every judgement.
 
     Notes
     -----
@@ -920,15 +983,79 @@ def design_lattice(
         if nodes == "branch"
         else np.arange(lattice.network.n_nodes)
     )
+    history: list[float] = []
+    nit = 0
+    counted = [0]  # solves of the equilibria objects no longer in use
+    judgements = [0]
+    judged: list[tuple[FloatArray, FloatArray, _Check, BathCheck]] = []
+
+    def designed(
+        modes: FloatArray,
+        speeds: FloatArray,
+        check: _Check,
+        verdict: BathCheck | None,
+        relaxed: FloatArray,
+    ) -> LatticeDesign:
+        final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
+        rms = float(np.sqrt(2.0 * j)) * size
+        printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
+        return LatticeDesign(
+            lattice=printed,
+            relaxed=relaxed,
+            modes=modes,
+            speeds=speeds,
+            positions=final.positions,
+            target=target,
+            objective_history=np.array(history),
+            misfit_rms=rms,
+            misfit_rel=rms / size,
+            achieved_gaussian_curvature=float(fit.gaussian_curvature),
+            target_gaussian_curvature=target.gaussian_curvature,
+            stable=stable,
+            iterations=nit,
+            solves=counted[0] + eq.solves,
+            bath=verdict,
+            judge_rounds=judgements[0],
+        )
+
+    if judge is not None and speed_range is not None:
+        # the starting pattern, printable, judged first: the judge's verified state is where
+        # the optimiser's solves start (the branch the judge takes), and a start the judge
+        # already finds reached is returned as it is (the simplest design: one speed per edge
+        # as given, no optimisation)
+        modes0 = np.where(c0 >= 0, 1.0, -1.0)
+        speeds0 = _printable_speeds(np.clip(v0, *speed_range), speed_range, speed_resolution)
+        verdict0 = judge(with_settings(lattice, modes0, speeds0))
+        judgements[0] += 1
+        state0 = verdict0.result.states[-1]
+
+        def from_start(p: FloatArray, state: State = state0) -> State:
+            return state
+
+        if lifting:
+            heated = from_start
+            eq = _Equilibria(blend, seed=seed, env=env, heated=heated)
+        if verdict0.reached:
+            p_start = np.concatenate([modes0, speeds0])
+            check0 = _verify(
+                blend, p_start, seed, target, picked, size, lattice, env=env, heated=from_start
+            )
+            counted[0] += check0.solves
+            return designed(modes0, speeds0, check0, verdict0, p_start)
     if speed_range is None:
         v_bounds = [(float(v), float(v)) for v in v0]
     else:
         v_bounds = [(float(speed_range[0]), float(speed_range[1]))] * n_edges
         # (0) the starting pattern at a few uniform speeds: the best one starts the descent
         # (K is far from monotonic in the speed, so the lattice's own speed may start far off)
-        starts = [np.clip(v0, *speed_range)] + [
-            np.full(n_edges, v) for v in np.geomspace(*speed_range, INITIAL_SPEEDS)
-        ]
+        uniform = np.geomspace(*speed_range, INITIAL_SPEEDS)
+        if heated is not None:
+            # on the lift probe's branch: strongest bending first, so the warm starts follow
+            # the lifted branch down from where it is lifted most (in rising order they start
+            # flat, where the floor holds every weaker design)
+            mismatch = np.abs(blend.chain.passive_strain - blend.chain.strains(uniform)[:, 0])
+            uniform = uniform[np.argsort(-mismatch, kind="stable")]
+        starts = [np.clip(v0, *speed_range)] + [np.full(n_edges, v) for v in uniform]
         signs0 = np.where(c0 >= 0, 1.0, -1.0)
         # one ramp, then warm starts along the speeds
         scan = _Equilibria(blend, seed=seed, env=env, heated=heated)
@@ -937,9 +1064,15 @@ def design_lattice(
             for v in starts
         ]
         eq.solves += sum(t.solves for t in tried0)
-        k0 = min(range(len(starts)), key=lambda i: (not tried0[i].stable, tried0[i].misfit))
+        order: list[int] = list(range(len(starts)))
+        if heated is not None and target.gaussian_curvature is not None:
+            # a curved target is not reached from the flat resting state the floor holds a
+            # weak design in (the descent on that branch is blind): start from the lifted
+            # candidates where any is stable
+            lifted = [i for i in order if tried0[i].stable and _lifted(tried0[i], lattice)]
+            order = lifted or order
+        k0 = min(order, key=lambda i: (not tried0[i].stable, tried0[i].misfit))
         v0 = starts[k0]
-    history: list[float] = []
     weight = [printability]
 
     def fun(p: FloatArray) -> tuple[float, FloatArray]:
@@ -1001,85 +1134,105 @@ def design_lattice(
     best_res = best_check.result
     modes = best[:n_edges].copy()
     speeds = best[n_edges:].copy()
-    # (3) the speeds alone with the modes fixed, warm-started from the verified state
-    if speed_range is not None:
-        eq.last = (best, best_res.state)
-        weight[0] = 0.0
 
-        def fun_v(v: FloatArray) -> tuple[float, FloatArray]:
-            j, g = fun(np.concatenate([modes, v]))
-            return j, g[n_edges:]
+    def refine(start_p: FloatArray, start_state: State) -> tuple[FloatArray, _Check, int]:
+        """Phases (3)-(5) from the design ``start_p`` solved in ``start_state``, with the
+        current ``eq`` and ``heated`` (the branch the solves start on)."""
+        speeds = start_p[n_edges:].copy()
+        its = 0
+        # (3) the speeds alone with the modes fixed, warm-started from the verified state
+        if speed_range is not None:
+            eq.last = (start_p, start_state)
+            weight[0] = 0.0
 
-        opt = lbfgs(fun_v, speeds, v_bounds, max_iterations)
-        speeds = opt.x
-        nit += int(opt.nit)
-        # (4) printable speeds
-        speeds = _printable_speeds(speeds, speed_range, speed_resolution)
-    # verification as the forward simulation does it: a fresh ramp from the flat printed state
-    base = speeds
+            def fun_v(v: FloatArray) -> tuple[float, FloatArray]:
+                j, g = fun(np.concatenate([modes, v]))
+                return j, g[n_edges:]
 
-    near = _Equilibria(blend, seed=seed, env=env, heated=heated)
+            opt = lbfgs(fun_v, speeds, v_bounds, max_iterations)
+            its = int(opt.nit)
+            # (4) printable speeds
+            speeds = _printable_speeds(opt.x, speed_range, speed_resolution)
+        base = speeds
+        near = _Equilibria(blend, seed=seed, env=env, heated=heated)
 
-    def check_scale(scale: float) -> tuple[FloatArray, _Check]:
-        v = base
-        if scale != 1.0:
-            v = _same_strength(blend, scale * modes, base, speed_range or MEASURED_SPEEDS)
-            v = _printable_speeds(v, speed_range or MEASURED_SPEEDS, speed_resolution)
-        # scaled designs warm-started from the base design's fresh equilibrium
-        near.last = None if scale == 1.0 else (base_p, tried[1.0][1].result.state)
-        p_s = np.concatenate([modes, v])
-        checked = _verify(blend, p_s, seed, target, picked, size, lattice, near)
-        eq.solves += checked.solves
-        return v, checked
+        def check_scale(scale: float) -> tuple[FloatArray, _Check]:
+            v = base
+            if scale != 1.0:
+                v = _same_strength(blend, scale * modes, base, speed_range or MEASURED_SPEEDS)
+                v = _printable_speeds(v, speed_range or MEASURED_SPEEDS, speed_resolution)
+            # scaled designs warm-started from the base design's fresh equilibrium
+            near.last = None if scale == 1.0 else (base_p, tried[1.0][1].result.state)
+            p_s = np.concatenate([modes, v])
+            checked = _verify(blend, p_s, seed, target, picked, size, lattice, near)
+            counted[0] += checked.solves
+            return v, checked
 
-    base_p = np.concatenate([modes, base])
-    tried: dict[float, tuple[FloatArray, _Check]] = {}
-    tried[1.0] = check_scale(1.0)
-    if speed_range is not None and target.gaussian_curvature is not None:
-        # (5) the overall bending strength scaled about the optimum (every edge's mismatch
-        # times s): the misfit is flat in this direction near its optimum, the target's K is
-        # not. A coarse grid, then two rounds of halved steps about the best scale.
-        for scale in STRENGTH_SCALES:
-            tried[scale] = check_scale(scale)
-        step = 0.04
-        for _ in range(2):
-            best_s = min(tried, key=lambda k: tried[k][1].rank)
-            for scale in (best_s * (1 - step), best_s * (1 + step)):
-                tried.setdefault(scale, check_scale(scale))
-            step /= 2
-    speeds, check = min(tried.values(), key=lambda t: t[1].rank)
-    if check is not tried[1.0][1]:
-        # the chosen scale verified as the forward simulation runs it: a fresh ramp (kept only
-        # if it is still better than the fresh base design)
-        fresh = _verify(
-            blend,
-            np.concatenate([modes, speeds]),
-            seed,
-            target,
-            picked,
-            size,
-            lattice,
-            env=env,
-            heated=heated,
+        base_p = np.concatenate([modes, base])
+        tried: dict[float, tuple[FloatArray, _Check]] = {}
+        tried[1.0] = check_scale(1.0)
+        if speed_range is not None and target.gaussian_curvature is not None:
+            # (5) the overall bending strength scaled about the optimum (every edge's mismatch
+            # times s): the misfit is flat in this direction near its optimum, the target's K
+            # is not. A coarse grid, then two rounds of halved steps about the best scale.
+            for scale in STRENGTH_SCALES:
+                tried[scale] = check_scale(scale)
+            step = 0.04
+            for _ in range(2):
+                best_s = min(tried, key=lambda k: tried[k][1].rank)
+                for scale in (best_s * (1 - step), best_s * (1 + step)):
+                    tried.setdefault(scale, check_scale(scale))
+                step /= 2
+        speeds, check = min(tried.values(), key=lambda t: t[1].rank)
+        if check is not tried[1.0][1]:
+            # the chosen scale verified by a fresh solve from the branch's start (kept only if
+            # it is still better than the fresh base design)
+            fresh = _verify(
+                blend,
+                np.concatenate([modes, speeds]),
+                seed,
+                target,
+                picked,
+                size,
+                lattice,
+                env=env,
+                heated=heated,
+            )
+            counted[0] += fresh.solves
+            speeds, check = min([(speeds, fresh), tried[1.0]], key=lambda t: t[1].rank)
+        return speeds, check, its
+
+    start_p, start_state = best, best_res.state
+    while True:
+        speeds, check, its = refine(start_p, start_state)
+        nit += its
+        if judge is None:
+            break
+        verdict = judge(with_settings(lattice, modes, speeds if speed_range is not None else None))
+        judged.append((modes, speeds, check, verdict))
+        judgements[0] += 1
+        logger.info(
+            "judgement %d: verified K = %.4g 1/mm² (error %s), optimiser's K = %.4g; %s",
+            judgements[0],
+            verdict.gaussian_curvature,
+            "n/a" if verdict.error_rel is None else f"{100 * verdict.error_rel:.1f} %",
+            float(check.fit.gaussian_curvature),
+            "reached" if verdict.reached else verdict.reason,
         )
-        eq.solves += fresh.solves
-        speeds, check = min([(speeds, fresh), tried[1.0]], key=lambda t: t[1].rank)
-    final, j, stable, fit = check.result, check.misfit, check.stable, check.fit
-    rms = float(np.sqrt(2.0 * j)) * size
-    printed = with_settings(lattice, modes, speeds if speed_range is not None else None)
-    return LatticeDesign(
-        lattice=printed,
-        relaxed=relaxed,
-        modes=modes,
-        speeds=speeds,
-        positions=final.positions,
-        target=target,
-        objective_history=np.array(history),
-        misfit_rms=rms,
-        misfit_rel=rms / size,
-        achieved_gaussian_curvature=float(fit.gaussian_curvature),
-        target_gaussian_curvature=target.gaussian_curvature,
-        stable=stable,
-        iterations=nit,
-        solves=eq.solves,
-    )
+        if verdict.reached or len(judged) >= JUDGE_ROUNDS or speed_range is None:
+            break
+        # the judge's ramp ended on another branch, or off the target: the optimiser starts
+        # again from the state that ramp verified, so it works on the branch the judge takes
+        branch_state = verdict.result.states[-1]
+
+        def on_branch(p: FloatArray, state: State = branch_state) -> State:
+            return state
+
+        heated = on_branch
+        counted[0] += eq.solves
+        eq = _Equilibria(blend, seed=seed, env=env, heated=heated)
+        start_p, start_state = np.concatenate([modes, speeds]), branch_state
+    verdict_kept: BathCheck | None = None
+    if judged:
+        modes, speeds, check, verdict_kept = min(judged, key=lambda t: _verdict_rank(t[3]))
+    return designed(modes, speeds, check, verdict_kept, relaxed)

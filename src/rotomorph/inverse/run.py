@@ -439,11 +439,13 @@ def inverse_file(
     k_t, k_a = s["target_gaussian_curvature"], s["achieved_gaussian_curvature"]
     kt = "" if k_t is None else f"target K {k_t:.3g} 1/mm², "
     band = "" if s["band"] is None else f" ± {s['band']['gaussian_curvature_sd_calibration']:.2g}"
+    sd_n = None if s["band"] is None else s["band"].get("gaussian_curvature_sd_nuisance")
+    nuisance = "" if sd_n is None else f", ± {sd_n:.2g} (nuisance inputs)"
     where = _surroundings_text(s["contact"])
     verdict = "REACHED" if s["reached"] else f"NOT REACHED: {s['verified']['reason']}"
     return (
         f"wrote {design_path} and {folder}/: designed and verified {where} by simulate's "
-        f"ramp: {kt}verified K {k_a:.3g}{band} 1/mm² (calibration band), misfit "
+        f"ramp: {kt}verified K {k_a:.3g}{band} 1/mm² (calibration band){nuisance}, misfit "
         f"{s['misfit_rms_mm']:.3g} mm ({100 * s['misfit_rel']:.2g} % of the size); {verdict}"
     )
 
