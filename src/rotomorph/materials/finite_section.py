@@ -77,6 +77,8 @@ def fibre_energy(
     eigen_stretch: FloatArray,
     volume: FloatArray,
     curvature: FloatArray,
+    *,
+    derivatives: bool = True,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Energy U (N), gradient ``(n, 3)`` and Hessian ``(n, 3, 3)`` in y = (a, G1, G2).
 
@@ -90,6 +92,8 @@ def fibre_energy(
         λ* and J* at the quadrature points ``(n, Q)`` (dimensionless).
     curvature
         Printed curvature k0 ``(n, 2)`` (1/mm).
+    derivatives
+        ``False``: the energy only (empty gradient and Hessian).
 
     Returns
     -------
@@ -105,11 +109,13 @@ def fibre_energy(
     positive = np.all(s > 0.0, axis=1)
     ss = np.where(s > 0.0, s, 1.0)
     energy = np.where(positive, np.sum(c * 0.5 * (ss * ss + 2.0 / ss - 3.0), axis=1), np.inf)
+    if not derivatives:
+        return energy, np.empty((0, 3)), np.empty((0, 3, 3))
     v = lever[None, :, :] / (f * eigen_stretch)[:, None, :]  # (n, 3, Q) ds/dy
     d1 = c * (ss - 1.0 / ss**2)
     d2 = c * (1.0 + 2.0 / ss**3)
-    gradient = np.einsum("nq,niq->ni", d1, v)
-    hessian = np.einsum("nq,niq,njq->nij", d2, v, v)
+    gradient = (v @ d1[:, :, None])[:, :, 0]
+    hessian = (v * d2[:, None, :]) @ v.transpose(0, 2, 1)
     return energy, gradient, hessian
 
 
@@ -144,23 +150,30 @@ def minimise(
         y = np.column_stack([np.ones(len(k0)) * lam.min(axis=1), lam.min(axis=1)[:, None] * k0])
         energy, grad, hess = fibre_energy(y, quadrature, lam, vol, k0)
     scale = quadrature.points.std()  # mm: makes the step's parts comparable
+    done = np.zeros(len(y), dtype=bool)
     for _ in range(_MAX_ITERATIONS):
-        step = -np.linalg.solve(hess, grad[..., None])[..., 0]
+        live = np.flatnonzero(~done)  # converged rows stay as they are
+        step = -np.linalg.solve(hess[live], grad[live][..., None])[..., 0]
         size = np.abs(step[:, 0]) + scale * np.abs(step[:, 1:]).sum(axis=1)
-        if np.all(size <= _TOLERANCE * np.abs(y[:, 0])):
+        finished = size <= _TOLERANCE * np.abs(y[live, 0])
+        done[live[finished]] = True
+        if done.all():
             return y
-        t = np.ones(len(y))
-        slope = np.einsum("ni,ni->n", grad, step)  # −(Newton decrement)²
+        live, step = live[~finished], step[~finished]
+        lam_l, vol_l, k0_l = lam[live], vol[live], k0[live]
+        slope = np.einsum("ni,ni->n", grad[live], step)  # −(Newton decrement)²
         # below round-off of the energy the merit test says nothing: take the full step
-        resolved = -slope > 1e-10 * np.abs(energy)
+        resolved = -slope > 1e-10 * np.abs(energy[live])
+        t = np.ones(len(live))
         for _ in range(40):  # backtracking on U (a true merit function)
-            trial = y + t[:, None] * step
-            e_new, g_new, h_new = fibre_energy(trial, quadrature, lam, vol, k0)
-            bad = ~(e_new <= energy + 1e-4 * t * slope) & (resolved | ~np.isfinite(e_new))
+            trial = y[live] + t[:, None] * step
+            e_new = fibre_energy(trial, quadrature, lam_l, vol_l, k0_l, derivatives=False)[0]
+            bad = ~(e_new <= energy[live] + 1e-4 * t * slope) & (resolved | ~np.isfinite(e_new))
             if not bad.any():
                 break
             t = np.where(bad, 0.5 * t, t)
-        y, energy, grad, hess = trial, e_new, g_new, h_new
+        y[live] = trial
+        energy[live], grad[live], hess[live] = fibre_energy(trial, quadrature, lam_l, vol_l, k0_l)
     raise ConvergenceError(
         f"neo-Hookean section: Newton did not converge in {_MAX_ITERATIONS} iterations"
     )
