@@ -162,8 +162,11 @@ def minimise(
         live, step = live[~finished], step[~finished]
         lam_l, vol_l, k0_l = lam[live], vol[live], k0[live]
         slope = np.einsum("ni,ni->n", grad[live], step)  # −(Newton decrement)²
-        # below round-off of the energy the merit test says nothing: take the full step
-        resolved = -slope > 1e-10 * np.abs(energy[live])
+        # below round-off of the energy the merit test says nothing, and a step this small
+        # from a strictly convex energy is the exact quadratic model's: take the full step
+        resolved = (-slope > 1e-10 * np.abs(energy[live])) & (
+            size[~finished] > 1e-8 * np.abs(y[live, 0])
+        )
         t = np.ones(len(live))
         for _ in range(40):  # backtracking on U (a true merit function)
             trial = y[live] + t[:, None] * step
