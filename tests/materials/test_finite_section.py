@@ -195,3 +195,15 @@ def test_the_strain_measure_only_relabels_the_same_stretches() -> None:
     eps_e, k_e, _ = engineering.natural_strains(0.5, *(stretches - 1.0))
     assert np.exp(eps_h[0]) == pytest.approx(1.0 + eps_e[0], rel=1e-12)
     np.testing.assert_allclose(k_h, k_e, rtol=1e-10, atol=1e-14)
+
+
+def test_nearly_unactuated_states_converge_to_the_linear_values() -> None:
+    # the start of a heating ramp: eigenstrains near round-off of the energy
+    lin = filament_section(R, EA, EP, resolution=48)
+    nh = with_law(lin, "neo-hookean", "hencky")
+    for scale in (1e-5, 1e-8):
+        state = (0.0, -0.4 * scale, 0.2 * scale, 0.03 * scale)
+        eps_lin, k_lin, _ = lin.natural_strains(*state)
+        eps_nh, k_nh, _ = nh.natural_strains(*state)
+        assert eps_nh[0] == pytest.approx(eps_lin[0], rel=1e-3)
+        assert k_nh[0, 0] == pytest.approx(k_lin[0, 0], rel=1e-3)
