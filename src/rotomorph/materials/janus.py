@@ -17,13 +17,15 @@ distort the section and are ignored by rod theory.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property, lru_cache
+from typing import Literal
 
 import numpy as np
 
 from rotomorph._typing import FloatArray, IntArray
 from rotomorph.errors import InvalidParameterError
+from rotomorph.materials import finite_section as finite
 from rotomorph.materials.mesh import SectionMesh, disk_mesh
 from rotomorph.materials.section import AxialSection, axial_section, phase_constant
 from rotomorph.materials.torsion import TorsionSection, torsion_section
@@ -63,13 +65,18 @@ class FilamentSection:
 
     Build with :func:`filament_section` (cached). Stiffnesses: ``axial_stiffness`` EA (N),
     ``bending_stiffness1`` B1 toward m1 = n, ``bending_stiffness2`` B2 toward m2 = t × n,
-    ``twist_stiffness`` C (N·mm²).
+    ``twist_stiffness`` C (N·mm²). ``law``: ``"linear"`` (the small-strain section,
+    :mod:`~rotomorph.materials.section`) or ``"neo-hookean"`` (natural strain and curvature
+    from :mod:`~rotomorph.materials.finite_section`, the eigenstrains read in ``measure``);
+    :func:`with_law` gives a section's other law.
     """
 
     radius: float
     mesh: SectionMesh
     axial: AxialSection
     shear_moduli: tuple[float, float]  # G of the active and the passive phase (MPa)
+    law: Literal["linear", "neo-hookean"] = field(default="linear", kw_only=True)
+    measure: Literal["hencky", "engineering"] = field(default="hencky", kw_only=True)
     _solved: dict[bytes, FloatArray] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
@@ -201,7 +208,11 @@ class FilamentSection:
         # (einsum, not a matrix product: a row's sum must not depend on the batch's other rows)
         transverse = np.einsum("iq,q->i", eps_t, ew) / self.axial.axial_stiffness
         k0 = states[:, 4:6]
-        eps_c, dkappa = self.axial.natural_curved(eps_zz, k0, transverse)
+        if self.law == "neo-hookean":
+            eps_c, turning = self._finite(states[:, :4], k0)
+            dkappa = turning - k0
+        else:
+            eps_c, dkappa = self.axial.natural_curved(eps_zz, k0, transverse)
         out = np.column_stack([eps_c, dkappa])
         straight = ~np.any(k0, axis=1)
         if straight.any():  # exactly the straight section's values (bit for bit)
@@ -214,9 +225,71 @@ class FilamentSection:
         eps_zz, gamma = self.eigenfields(*states.T)
         # no eigen-shear (ω* = 0 everywhere): no natural twist, and no torsion solve for it
         twist = self.torsion.natural_twist(gamma) if np.any(gamma) else np.zeros(len(states))
+        if self.law == "neo-hookean":
+            eps_c, kappa = self._finite(states, np.zeros((len(states), 2)))
+            return np.column_stack([eps_c, kappa, twist])
         return np.column_stack(
             [self.axial.natural_strain(eps_zz), self.axial.natural_curvature(eps_zz), twist]
         )
+
+    def finite_fields(self, states: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Eigen-stretch λ* ``(n, Q)``, natural volume J* ``(n, Q)`` and mean transverse
+        stretch s_t ``(n,)`` of print states ``(n, 4)`` (ω*, ε∥, ε⊥, ε_p in ``measure``), the
+        eigen-deformation of :mod:`~rotomorph.materials.finite_section`."""
+        from rotomorph.materials.process import strain_to_stretch
+
+        w = states[:, :1]
+        l_par, l_perp, l_p = (
+            np.asarray(strain_to_stretch(states[:, i : i + 1], self.measure)) for i in (1, 2, 3)
+        )
+        lam2, denom = self._axial_eigenstrain(w, l_par**2, l_perp**2, l_p**2)
+        act = self.axial.active
+        volume = np.where(act, l_par * l_perp**2, l_p**3)
+        sin2 = 1.0 - 1.0 / denom
+        azimuthal = np.sqrt(l_perp**2 + (l_par**2 - l_perp**2) * sin2)
+        lateral = np.where(act, 0.5 * (l_perp + azimuthal), l_p)
+        ew = self.axial.modulus * self.axial.weights
+        transverse = np.einsum("iq,q->i", lateral, ew) / self.axial.axial_stiffness
+        return np.sqrt(lam2), volume, transverse
+
+    def fibre_quadrature(self) -> finite.FibreQuadrature:
+        """The section's quadrature for :mod:`~rotomorph.materials.finite_section`."""
+        a = self.axial
+        return finite.FibreQuadrature(a.points, a.weights, a.modulus, a.centroid)
+
+    def _finite(self, states: FloatArray, k0: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Neo-Hookean natural strain ``(n,)`` (``measure``) and turning per printed length
+        ``(n, 2)`` (1/mm) of print states ``(n, 4)`` printed with curvature k0 ``(n, 2)``."""
+        from rotomorph.materials.process import stretch_to_strain
+
+        if self.axial.folded_moment is not None:
+            raise InvalidParameterError(
+                "FilamentSection.law", "solve a folded stack on its full section (with_law)"
+            )
+        lam, volume, transverse = self.finite_fields(states)
+        quad = self.fibre_quadrature()
+        y = finite.minimise(quad, lam, volume, k0)
+        stretch, turning = finite.natural_state(y, quad, k0, transverse)
+        return np.asarray(stretch_to_strain(stretch, self.measure)), turning
+
+
+@lru_cache(maxsize=64)
+def with_law(
+    section: FilamentSection,
+    law: Literal["linear", "neo-hookean"],
+    measure: Literal["hencky", "engineering"],
+) -> FilamentSection:
+    """``section`` with natural strains from ``law`` (eigenstrains in ``measure``); the same
+    object for the linear law. A folded stack is replaced by its full section (the same
+    values, without the fold the fibre energy does not admit). Cached per section."""
+    if law not in finite.SECTION_MODELS:
+        raise InvalidParameterError(
+            "section law", f"must be one of {finite.SECTION_MODELS}; got {law!r}"
+        )
+    if law == "linear":
+        return section
+    base = getattr(section, "full", section)
+    return replace(base, law=law, measure=measure)
 
 
 def _remembered(

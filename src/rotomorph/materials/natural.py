@@ -42,7 +42,13 @@ from rotomorph import geometry
 from rotomorph._display import compact_display
 from rotomorph._typing import BoolArray, FloatArray
 from rotomorph.errors import InvalidDesignError, InvalidParameterError, MaterialError
-from rotomorph.materials.janus import DEFAULT_RESOLUTION, FilamentSection, filament_section
+from rotomorph.materials.finite_section import SECTION_MODELS
+from rotomorph.materials.janus import (
+    DEFAULT_RESOLUTION,
+    FilamentSection,
+    filament_section,
+    with_law,
+)
 from rotomorph.materials.material import Material, get_material
 from rotomorph.materials.morphology import HelixShape, free_helix
 from rotomorph.materials.parameter_set import default_materials
@@ -184,6 +190,11 @@ class FilamentModel:
         :meth:`MaterialSet.filament_model
         <rotomorph.materials.parameter_set.MaterialSet.filament_model>` builds the model of a
         set's ink pair.
+    section_model
+        ``"linear"`` (default): the small-strain section (:mod:`rotomorph.materials.section`);
+        ``"neo-hookean"``: natural strain and curvature of the incompressible neo-Hookean
+        section at finite fibre strain (:mod:`rotomorph.materials.finite_section`), same moduli,
+        no new parameter. Stiffnesses and natural twist are the linear section's in both.
     """
 
     strain_model: ActuationStrainModel = field(default_factory=_calibrated_strain_model)
@@ -198,8 +209,14 @@ class FilamentModel:
     print_temperature: float = _PAPER["print_temperature"]
     actuation_temperature: float = _PAPER["actuation_temperature"]
     materials: MaterialSet | None = None
+    section_model: Literal["linear", "neo-hookean"] = "linear"
 
     def __post_init__(self) -> None:
+        if self.section_model not in SECTION_MODELS:
+            raise InvalidParameterError(
+                "FilamentModel.section_model",
+                f"must be one of {SECTION_MODELS}; got {self.section_model!r}",
+            )
         if not isinstance(self.strain_model, ActuationStrainModel):
             raise InvalidParameterError(
                 "FilamentModel.strain_model", "must implement active_strains(speed) and measure"
@@ -300,8 +317,9 @@ class FilamentModel:
             active_fraction=active_fraction,
             resolution=self.resolution,
         )
+        measure = self.strain_model.measure
         if stack is not None and stack.layers > 1:
-            return stack_section(
+            stacked = stack_section(
                 radius,
                 stack.layers,
                 stack.layer_height,
@@ -310,7 +328,9 @@ class FilamentModel:
                 direction=stack.direction or (0.0, 1.0),
                 **common,  # type: ignore[arg-type]
             )
-        return filament_section(radius, e_a, e_p, **common)  # type: ignore[arg-type]
+            return with_law(stacked, self.section_model, measure)
+        one = filament_section(radius, e_a, e_p, **common)  # type: ignore[arg-type]
+        return with_law(one, self.section_model, measure)
 
     def strains(
         self, speed: float | FloatArray, passive: Material
