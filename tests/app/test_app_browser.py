@@ -3,8 +3,9 @@ would — opens the dome example, switches two edges by clicking them, sees the 
 runs a 4-step simulation to its end with the progress shown, moves the slider, downloads the
 G-code and finds it byte-identical to ``rotomorph gcode`` of the same design; an invalid edit
 shows the CLI's own error next to the field; a 5 MB upload is refused; a design with markup in
-every text field is shown as text. One server for the module; the screenshots in docs/ are
-taken here.
+every text field is shown as text. One server and one browser for the module; the server's
+workers start cold (``--no-prewarm``: these tests measure no first step's latency, and every
+page opened would otherwise warm a worker up); the screenshots in docs/ are taken here.
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ def server():
             str(ROOT / "examples"),
             "--max-jobs",
             "2",
+            "--no-prewarm",
         ],
         stderr=subprocess.PIPE,
         stdout=subprocess.DEVNULL,

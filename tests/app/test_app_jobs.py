@@ -1,6 +1,10 @@
 """Background jobs: a session's worker process streams each converged step and writes the run
 with the CLI's own functions; one job per session and a cap over all sessions; cancel ends the
-job at once and the session gets a fresh worker."""
+job at once and the session gets a fresh worker; a worker warms up unless told not to, and a
+job submitted during its warm-up does not wait for it.
+
+These tests measure no first step's latency, so their sessions' workers start cold (the
+warm-up's own test excepted): the first job loads the kernels it needs itself."""
 
 from __future__ import annotations
 
@@ -11,7 +15,8 @@ import numpy as np
 import pytest
 import tomli_w
 
-from rotomorph.app.jobs import BusyError, Job, Sessions
+from rotomorph.app.jobs import BusyError, Job, Sessions, Worker
+from rotomorph.app.worker import WARM_STAGES
 from rotomorph.cli import main
 from rotomorph.io.results import read_results
 
@@ -46,7 +51,7 @@ def _wait(sessions: Sessions, sid: str, until, timeout: float = 180.0) -> Job:
 
 @pytest.fixture(scope="module")
 def sessions():
-    s = Sessions(max_jobs=1)
+    s = Sessions(max_jobs=1, prewarm=False)
     yield s
     s.close()
 
@@ -160,3 +165,36 @@ def test_a_failed_job_reports_the_clis_line(sessions):
     job = _wait(sessions, sid, lambda j: not j.running)
     assert job.state == "failed"
     assert job.error.startswith("filaments[0].speed: must be >= ")
+
+
+def _ready(worker: Worker, timeout: float = 180.0) -> None:
+    end = time.monotonic() + timeout
+    while not worker.ready:
+        assert time.monotonic() < end, "the worker never reported ready"
+        worker.poll()
+        time.sleep(0.1)
+
+
+def test_a_worker_warms_up_and_a_job_submitted_meanwhile_does_not_wait():
+    worker = Worker(prewarm=True)
+    try:
+        _ready(worker)  # idle: every warm-up design heated
+        assert worker.warmed == [name for name, _ in WARM_STAGES] == ["filament", "lattice"]
+        worker.cancel()  # a fresh process, warming up again; a job at once
+        assert not worker.ready and worker.warmed == []
+        job = Job("simulate", steps=1)
+        worker.submit(job, {"kind": "simulate", "design": DESIGN, "steps": 1})
+        end = time.monotonic() + 180.0
+        while worker.poll() is job and job.running:
+            assert time.monotonic() < end, "the job never ended"
+            time.sleep(0.1)
+        assert job.state == "done", job.error
+        assert worker.ready and "lattice" not in worker.warmed  # the job stopped the warm-up
+    finally:
+        worker.close()
+    cold = Worker(prewarm=False)
+    try:
+        _ready(cold)
+        assert cold.warmed == []
+    finally:
+        cold.close()

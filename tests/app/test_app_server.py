@@ -121,9 +121,10 @@ def test_clicked_edges_make_a_custom_pattern():
 
 @pytest.fixture(scope="module")
 def client():
+    from rotomorph.app.jobs import Sessions
     from rotomorph.app.server import create_app
 
-    app, sessions = create_app(examples=EXAMPLES)
+    app, sessions = create_app(examples=EXAMPLES, sessions=Sessions(prewarm=False))
     yield app.server.test_client()
     sessions.close()
 
@@ -200,6 +201,8 @@ def test_serve_arguments_are_checked(capsys):
 
     args = build_parser().parse_args(["serve"])
     assert args.host == "127.0.0.1" and args.open is True
+    assert args.prewarm is True  # a served session's worker warms up unless told not to
+    assert build_parser().parse_args(["serve", "--no-prewarm"]).prewarm is False
 
 
 def test_a_taken_port_is_a_one_line_error(capsys):

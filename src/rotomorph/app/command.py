@@ -48,6 +48,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=None,
         help="simulations and inverse designs running at once over all sessions (default: cores)",
     )
+    p.add_argument(
+        "--no-prewarm",
+        dest="prewarm",
+        action="store_false",
+        help="start each session's worker cold: no warm-up heating while the person designs "
+        "(less CPU; a lattice's first simulated step then comes later)",
+    )
 
 
 def command(args: argparse.Namespace) -> int:
@@ -71,7 +78,7 @@ def command(args: argparse.Namespace) -> int:
     local = args.host in LOCAL_HOSTS
     app, sessions = create_app(
         examples=examples,
-        sessions=Sessions(max_jobs=args.max_jobs),
+        sessions=Sessions(max_jobs=args.max_jobs, prewarm=args.prewarm),
         allowed_hosts=LOCAL_HOSTS if local else None,
     )
     import socket

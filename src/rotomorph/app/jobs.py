@@ -2,7 +2,8 @@
 
 Every browser session gets one :class:`Worker`: a separate process (``spawn`` start method: it
 shares no threads, locks or sockets with the web server) that imports the solver and loads its
-compiled kernels as soon as the session opens, so a "simulate" starts warm. A job is a dict sent
+compiled kernels as soon as the session opens, so a "simulate" starts warm (``prewarm``; a job
+submitted during the warm-up stops it and runs at once). A job is a dict sent
 to the worker; its events (:mod:`rotomorph.app.worker`) are collected by :meth:`Worker.poll`,
 which the page calls a few times a second: the server never waits on a computation, so the
 page never blocks.
@@ -69,12 +70,21 @@ class Job:
 
 
 class Worker:
-    """A session's worker process and its current job."""
+    """A session's worker process and its current job.
 
-    def __init__(self) -> None:
+    Parameters
+    ----------
+    prewarm
+        Each process heats the warm-up designs before its first job
+        (:func:`rotomorph.app.worker.run_worker`); ``False`` starts it cold.
+    """
+
+    def __init__(self, *, prewarm: bool = True) -> None:
         self._ctx = mp.get_context("spawn")
         self._process: Any = None
+        self.prewarm = prewarm
         self.ready = False
+        self.warmed: list[str] = []  # the warm-up stages the current process heated
         self.job: Job | None = None
         self.folder = Path(tempfile.mkdtemp(prefix="rotomorph-app-"))
         self._runs = 0
@@ -86,10 +96,11 @@ class Worker:
         self._inbox = self._ctx.Queue()
         self._outbox = self._ctx.Queue()
         self._process = self._ctx.Process(
-            target=run_worker, args=(self._inbox, self._outbox), daemon=True
+            target=run_worker, args=(self._inbox, self._outbox, self.prewarm), daemon=True
         )
         self._process.start()
         self.ready = False
+        self.warmed = []
 
     @property
     def alive(self) -> bool:
@@ -124,6 +135,7 @@ class Worker:
         kind = event["kind"]
         if kind == "ready":
             self.ready = True
+            self.warmed = list(event["warmed"])
             return
         job = self.job
         if job is None or not job.running:
@@ -192,11 +204,20 @@ class Sessions:
         its worker up when a new session needs one.
     idle_timeout
         Seconds after which a session that was not seen loses its worker and files.
+    prewarm
+        Workers warm up before their first job (:class:`Worker`); ``False`` where the first
+        step's latency does not matter (it then includes loading the kernels).
     """
 
     def __init__(
-        self, *, max_jobs: int | None = None, max_workers: int = 8, idle_timeout: float = 3600.0
+        self,
+        *,
+        max_jobs: int | None = None,
+        max_workers: int = 8,
+        idle_timeout: float = 3600.0,
+        prewarm: bool = True,
     ) -> None:
+        self.prewarm = prewarm
         self.max_jobs = max(1, max_jobs or os.cpu_count() or 1)
         self.max_workers = max(1, max_workers)
         self.idle_timeout = idle_timeout
@@ -238,7 +259,7 @@ class Sessions:
                     assert oldest.worker is not None
                     oldest.worker.close()
                     oldest.worker = None
-                session.worker = Worker()
+                session.worker = Worker(prewarm=self.prewarm)
             return session.worker
 
     def job(self, sid: str) -> Job | None:

@@ -5,7 +5,9 @@ server's threads) that receives one job at a time on its inbox and puts *events*
 of numbers, strings and numpy arrays) on its outbox:
 
 ``ready``
-    The worker has imported the solver and loaded its compiled kernels (warm).
+    The worker is ready for jobs; ``warmed`` names the warm-up designs it heated (all of
+    :data:`WARM_STAGES` when it was idle, fewer when a job arrived during the warm-up, none
+    when it was started without one).
 ``topology``
     A simulation's network: ``edges``, per-edge ``radius`` and ``active_fraction``, the
     ``chains`` (one per filament), ``printed`` positions and the design's name.
@@ -34,6 +36,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import queue
 import traceback
 from pathlib import Path
 from typing import Any
@@ -86,12 +89,55 @@ class _Phases(logging.Handler):
             pass
 
 
-def _warm() -> None:
-    from rotomorph.io.designfile import parse_design
-    from rotomorph.simulate.design import simulate_design
+#: The warm-up, in order: each design is heated one step unless a job is already waiting.
+WARM_STAGES = (("filament", WARM_DESIGN), ("lattice", WARM_LATTICE))
 
-    simulate_design(parse_design(dict(WARM_DESIGN)), steps=1)
-    simulate_design(parse_design(dict(WARM_LATTICE)), steps=1)
+
+class _JobWaiting(Exception):
+    """A job arrived during the warm-up: the warm-up stops and the job runs."""
+
+
+def _warm(inbox: Any) -> tuple[list[str], list[Any]]:
+    """Heat the :data:`WARM_STAGES` designs until a job arrives on ``inbox``.
+
+    A job that arrives during the warm-up does not wait for it: between the stages, and at a
+    stage's printed state (before its heating step, where the kernels load), the inbox is
+    looked at and the warm-up stops there. The job then loads the kernels it needs itself, as
+    a worker without warm-up would.
+
+    Returns
+    -------
+    warmed
+        Names of the stages heated to their end.
+    waiting
+        What stopped the warm-up, taken from ``inbox`` (a job, or ``None`` to end the worker);
+        empty if the warm-up ran to its end.
+    """
+    from rotomorph.io.designfile import parse_design
+    from rotomorph.simulate.design import StepReport, simulate_design
+
+    waiting: list[Any] = []
+
+    def look() -> None:
+        try:
+            waiting.append(inbox.get_nowait())
+        except queue.Empty:
+            return
+        raise _JobWaiting
+
+    def on_step(report: StepReport) -> None:
+        if report.step == 0:
+            look()
+
+    warmed: list[str] = []
+    try:
+        for name, design in WARM_STAGES:
+            look()
+            simulate_design(parse_design(dict(design)), steps=1, on_step=on_step)
+            warmed.append(name)
+    except _JobWaiting:
+        pass
+    return warmed, waiting
 
 
 def _topology(design: Any) -> dict[str, Any]:
@@ -238,18 +284,30 @@ def _error(err: BaseException) -> dict[str, Any]:
     return {"kind": "error", "message": f"internal error: {tail}", "bad_input": False}
 
 
-def run_worker(inbox: Any, outbox: Any) -> None:
-    """Main loop of a worker process: warm up, then run jobs from ``inbox`` until ``None``."""
+def run_worker(inbox: Any, outbox: Any, prewarm: bool = True) -> None:
+    """Main loop of a worker process: warm up, then run jobs from ``inbox`` until ``None``.
+
+    Parameters
+    ----------
+    inbox, outbox
+        The queues of jobs (dicts; ``None`` ends the loop) and of events.
+    prewarm
+        Heat the warm-up designs first (:func:`_warm`), so that a lattice's first step comes
+        without compiling or loading kernels; a job that arrives meanwhile stops the warm-up.
+    """
     log = logging.getLogger("rotomorph.progress")
     log.setLevel(logging.INFO)
     log.addHandler(_Phases(outbox))
-    try:
-        _warm()
-    except Exception as err:  # a failed warm-up only costs the first job's speed
-        outbox.put({"kind": "phase", "text": f"warm-up failed: {type(err).__name__}"})
-    outbox.put({"kind": "ready"})
+    warmed: list[str] = []
+    waiting: list[Any] = []
+    if prewarm:
+        try:
+            warmed, waiting = _warm(inbox)
+        except Exception as err:  # a failed warm-up only costs the first job's speed
+            outbox.put({"kind": "phase", "text": f"warm-up failed: {type(err).__name__}"})
+    outbox.put({"kind": "ready", "warmed": warmed})
     while True:
-        job = inbox.get()
+        job = waiting.pop() if waiting else inbox.get()
         if job is None:
             return
         try:
