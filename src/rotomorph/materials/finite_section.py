@@ -1,23 +1,23 @@
 r"""Finite-strain (incompressible neo-Hookean) plane-section mechanics of an active section.
 
 The linear section (:mod:`rotomorph.materials.section`) minimises ½∫E(ε − ε*)² dA, valid for
-small fibre strains; a Janus filament at its peak curvature (|κ̄|·R ≈ 0.6) strains its outer
+small fibre strains; a Janus filament at its peak curvature (\|κ̄\|·R ≈ 0.6) strains its outer
 fibres by tens of per cent. This module keeps the same kinematics (plane sections, each fibre
 in uniaxial stress) and the same moduli (no new parameter), and replaces the quadratic energy
 by the incompressible neo-Hookean one of each fibre's elastic stretch:
 
-=========  ==============================================================  ==========
-symbol     definition                                                      unit
-=========  ==============================================================  ==========
+=========  ===============================================================  ==========
+symbol     definition                                                       unit
+=========  ===============================================================  ==========
 λ*         axial eigen-stretch of a fibre (free, stress-free stretch)       1
-J*         det F*, natural volume per reference volume                     1
+J*         det F*, natural volume per reference volume                      1
 f          1 − k0·x, reference fibre length per printed centre-line length  1
-a, G       centre-line stretch and rotation rate: λ(x) = (a − G·x)/f       1, 1/mm
-s          λ/λ*, elastic stretch                                           1
-μ          E/3, shear modulus of the incompressible solid                  MPa
+a, G       centre-line stretch and rotation rate: λ(x) = (a − G·x)/f        1, 1/mm
+s          λ/λ*, elastic stretch                                            1
+μ          E/3, shear modulus of the incompressible solid                   MPa
 Φ(s)       (s² + 2/s − 3)/2, uniaxial neo-Hookean energy per μ              1
-U(a, G)    Σ_q w_q f_q J*_q μ_q Φ(s_q), energy per printed length          N
-=========  ==============================================================  ==========
+U(a, G)    Σ_q w_q f_q J*_q μ_q Φ(s_q), energy per printed length           N
+=========  ===============================================================  ==========
 
 A fibre at x of the section (x from the geometric centre, mm) on a bar printed with curvature
 k0 has reference length ∝ f = 1 − k0·x (Winkler's curved bar) and, after actuation, length
