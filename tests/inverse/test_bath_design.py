@@ -137,6 +137,22 @@ def test_robust_design_minimises_the_expected_error_and_says_what_it_gives_up():
     assert set(choice.record()) >= {"strength_scale", "gives_up_nominally"}
 
 
+def _in_the_bath(lat):
+    """design_lattice's physics of the bath at 175 °C: the printed stack's contact, the floor,
+    the buoyant weight, the lowest branch."""
+    from rotomorph.contact import Contact
+    from rotomorph.inverse.environment import _program
+    from rotomorph.lattice.admissibility import lattice_stack
+
+    return dict(
+        actuation=_program(175.0),
+        contact=Contact(radius=lat.radius, self_contact=True, stack=lattice_stack(lat)),
+        floor=True,
+        gravity=lattice_buoyancy(lat)(175.0),
+        branch="lowest",
+    )
+
+
 @pytest.mark.slow
 def test_the_judge_restarts_the_optimiser_on_its_branch_and_never_passes_an_overlap(
     monkeypatch,
@@ -145,11 +161,8 @@ def test_the_judge_restarts_the_optimiser_on_its_branch_and_never_passes_an_over
     pattern and JUDGE_ROUNDS optimised designs are judged and none is reached; the solves
     after each judgement start from the state that verdict verified; the design returned is
     the best judged optimised one, with its verdict."""
-    from rotomorph.contact import Contact
     from rotomorph.inverse import lattice as lattice_module
-    from rotomorph.inverse.environment import _program
     from rotomorph.inverse.lattice import JUDGE_ROUNDS, _verdict_rank, design_lattice
-    from rotomorph.lattice.admissibility import lattice_stack
 
     lat = sinusoidal_lattice(
         n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
@@ -174,11 +187,7 @@ def test_the_judge_restarts_the_optimiser_on_its_branch_and_never_passes_an_over
     des = design_lattice(
         lat,
         target,
-        actuation=_program(175.0),
-        contact=Contact(radius=lat.radius, self_contact=True, stack=lattice_stack(lat)),
-        floor=True,
-        gravity=lattice_buoyancy(lat)(175.0),
-        branch="lowest",
+        **_in_the_bath(lat),
         max_iterations=2,
         judge=judge,
     )
@@ -198,10 +207,7 @@ def test_the_judge_restarts_the_optimiser_on_its_branch_and_never_passes_an_over
 def test_a_start_the_judge_finds_reached_is_returned_as_it_is():
     """The starting pattern is judged first: asked for the K its own ramp gives, the design
     is that pattern at its own (printable) speeds, reached, with no optimiser iteration."""
-    from rotomorph.contact import Contact
-    from rotomorph.inverse.environment import _program
     from rotomorph.inverse.lattice import SurfaceTarget, design_lattice
-    from rotomorph.lattice.admissibility import lattice_stack
 
     lat = sinusoidal_lattice(
         n=3, spacing=5.0, amplitude=1.25, ghost_nodes=6, pattern="dome", centre="interior"
@@ -214,11 +220,7 @@ def test_a_start_the_judge_finds_reached_is_returned_as_it_is():
     des = design_lattice(
         lat,
         target,
-        actuation=_program(175.0),
-        contact=Contact(radius=lat.radius, self_contact=True, stack=lattice_stack(lat)),
-        floor=True,
-        gravity=lattice_buoyancy(lat)(175.0),
-        branch="lowest",
+        **_in_the_bath(lat),
         judge=lambda printed: verify_in_bath(printed, k, diagnose=False),
     )
     assert des.reached and des.judge_rounds == 1 and des.iterations == 0

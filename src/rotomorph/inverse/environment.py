@@ -259,11 +259,19 @@ def _sigma_values(
     loads = None
     if contact_model.gravity:
         loads = Loads(gravity=lattice_buoyancy(lattice, bath=contact_model.bath)(temperature))
+    return _solved_or_nan(
+        lambda model: _heated_k(lattice, model, temperature, res.states[-1], contact, loads),
+        _sigma_models(temperature),
+    )
+
+
+def _solved_or_nan(solve: Any, inputs: Any) -> tuple[FloatArray, int]:
+    """``solve(x)`` for each input, NaN where it does not converge, and how many did not."""
     out = []
     failed = 0
-    for model in _sigma_models(temperature):
+    for x in inputs:
         try:
-            out.append(_heated_k(lattice, model, temperature, res.states[-1], contact, loads))
+            out.append(solve(x))
         except ConvergenceError:
             out.append(float("nan"))
             failed += 1
@@ -281,19 +289,15 @@ def _nuisance_values(
 
     res = check.result
     contact = None if res.contact is None else replace(res.contact, friction=0.0)
-    out = []
-    failed = 0
-    for sample in latin_hypercube(count, seed=0):
+
+    def solve(sample: Any) -> float:
         lat = replace(lattice, active_material=transition_material(sample.transition))
         loads = None
         if contact_model.gravity:
             loads = Loads(gravity=sample_buoyancy(lat, sample)(temperature))
-        try:
-            out.append(_heated_k(lat, None, temperature, res.states[-1], contact, loads))
-        except ConvergenceError:
-            out.append(float("nan"))
-            failed += 1
-    return np.asarray(out), failed
+        return _heated_k(lat, None, temperature, res.states[-1], contact, loads)
+
+    return _solved_or_nan(solve, latin_hypercube(count, seed=0))
 
 
 def design_band(
